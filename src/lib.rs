@@ -1,0 +1,15 @@
+//! # Sinew
+//!
+//! Joint-to-end stiffness of cable-driven hyper-redundant manipulators: how stiff each joint is
+//! for given cable tensions and angles, how stiff the end-effector is in a pose under a load,
+//! and how to distribute the tensions to make it stiffer without breaking static balance.
+//!
+//! This facade re-exports the workspace crates, each under a short name:
+//!
+//! - [`robot`]: URDF → immutable chain model, kinematics, Jacobians and their derivatives,
+//!   gravity torques (`sinew-robot`).
+//!
+//! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
+#![deny(missing_docs)]
+
+pub use sinew_robot as robot;
