@@ -52,6 +52,14 @@ impl Robot {
     }
 }
 
+/// One link's inertial, expressed in its body's frame.
+#[derive(Clone)]
+struct MassPart {
+    mass: f64,
+    com: Vector3<f64>,
+    inertia: Matrix3<f64>,
+}
+
 struct Builder<'a> {
     urdf: &'a urdf_rs::Robot,
     source: &'a str,
@@ -266,7 +274,7 @@ impl Builder<'_> {
                 inertia: Matrix3::zeros(),
             })
             .collect();
-        let mut parts: Vec<Vec<(f64, Vector3<f64>, Matrix3<f64>)>> = vec![Vec::new(); bodies.len()];
+        let mut parts: Vec<Vec<MassPart>> = vec![Vec::new(); bodies.len()];
         let mut links = Vec::with_capacity(n_links);
         for &l in &order {
             let Some((body, body_m_link)) = placement[l] else { continue };
@@ -277,22 +285,23 @@ impl Builder<'_> {
             let i = &inertial.inertia;
             let local = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
             let r = body_m_com.rotation.matrix();
-            parts[body].push((
-                inertial.mass.value,
-                body_m_com.translation.vector,
-                r * local * r.transpose(),
-            ));
+            parts[body].push(MassPart {
+                mass: inertial.mass.value,
+                com: body_m_com.translation.vector,
+                inertia: r * local * r.transpose(),
+            });
         }
         for (body, parts) in bodies.iter_mut().zip(&parts) {
-            let mass: f64 = parts.iter().map(|p| p.0).sum();
+            let mass: f64 = parts.iter().map(|p| p.mass).sum();
             if mass > 0.0 {
                 body.mass = mass;
-                body.com = parts.iter().map(|p| p.0 * p.1).sum::<Vector3<f64>>() / mass;
+                body.com = parts.iter().map(|p| p.mass * p.com).sum::<Vector3<f64>>() / mass;
                 body.inertia = parts
                     .iter()
-                    .map(|(m, c, inertia)| {
-                        let d = c - body.com;
-                        inertia + *m * (Matrix3::identity() * d.norm_squared() - d * d.transpose())
+                    .map(|p| {
+                        let d = p.com - body.com;
+                        p.inertia
+                            + p.mass * (Matrix3::identity() * d.norm_squared() - d * d.transpose())
                     })
                     .sum();
             }
