@@ -215,6 +215,41 @@ impl Robot {
         Ok(())
     }
 
+    /// `J(Q)ᵀ F`: the joint torques that balance a wrench `F = [f; m]` (base frame) exerted by a
+    /// body point on its environment (the load part of eq. 6). `out` has length dof.
+    ///
+    /// Computed without forming `J`: `(JᵀF)_j = f · (a_j × (p − p_j)) + m · a_j` for `j < b`.
+    ///
+    /// # Errors
+    /// [`RobotError::WorkspaceMismatch`], [`RobotError::NoSuchBody`],
+    /// [`RobotError::DimensionMismatch`].
+    pub fn wrench_torque(
+        &self,
+        data: &RobotData,
+        point: &BodyPoint,
+        wrench: &Vector6<f64>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        data.check(self)?;
+        self.check_body(point.body)?;
+        if out.len() != self.dof() {
+            return Err(RobotError::DimensionMismatch {
+                what: "wrench torque",
+                expected: self.dof(),
+                got: out.len(),
+            });
+        }
+        let f = wrench.fixed_rows::<3>(0).into_owned();
+        let m = wrench.fixed_rows::<3>(3).into_owned();
+        let p = world_point(data, point);
+        out.fill(0.0);
+        for j in 0..point.body {
+            let a = data.o_axis[j];
+            out[j] = f.dot(&a.cross(&(p - data.o_pivot[j]))) + m.dot(&a);
+        }
+        Ok(())
+    }
+
     /// `∂(J(Q)ᵀ F)/∂Q` for a wrench `F = [f; m]` fixed in the base frame (dof × dof).
     ///
     /// Entry `(j, i)` is `∂(J[:, j] · F)/∂q_i`. This is the load part of the paper's `W` term

@@ -120,6 +120,12 @@ impl Robot {
         self.gravity
     }
 
+    /// The same robot under another gravity vector (base frame, m/s²), e.g. zero to study the
+    /// load alone.
+    pub fn with_gravity(&self, gravity: Vector3<f64>) -> Robot {
+        Robot { gravity, ..self.clone() }
+    }
+
     /// Total mass of the moving bodies (every body but the root), kg.
     pub fn moving_mass(&self) -> f64 {
         self.bodies.iter().skip(1).map(|b| b.mass).sum()

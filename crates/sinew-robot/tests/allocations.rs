@@ -60,6 +60,7 @@ fn evaluating_a_configuration_allocates_nothing() {
             for i in 0..n {
                 robot.point_jacobian_derivative(&data, &tip, i, derivative.as_mut()).unwrap();
             }
+            robot.wrench_torque(&data, &tip, &wrench, &mut torque).unwrap();
             robot.wrench_torque_derivative(&mut data, &tip, &wrench, square.as_mut()).unwrap();
             robot.gravity_torque(&mut data, &mut torque).unwrap();
             robot.gravity_torque_derivative(&mut data, square.as_mut()).unwrap();

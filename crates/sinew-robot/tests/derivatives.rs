@@ -247,3 +247,21 @@ fn gravity_torque_derivative_matches_finite_differences_and_is_symmetric() {
         assert!(worst <= RTOL, "{name}: ∂T_g/∂Q error {worst:e} > {RTOL:e}");
     }
 }
+
+#[test]
+fn wrench_torque_is_jacobian_transpose_times_wrench() {
+    for (name, robot) in common::test_robots() {
+        let mut data = RobotData::new(&robot);
+        let mut rng = common::rng(16);
+        let mut out = vec![0.0; robot.dof()];
+        for _ in 0..CONFIGURATIONS {
+            let q = common::random_q(&robot, &mut rng);
+            let p = random_point(&robot, &mut rng);
+            let f = Vector6::from_fn(|_, _| rng.random_range(-10.0..10.0));
+            let expected = generalized_force(&robot, &mut data, &q, &p, &f);
+            robot.wrench_torque(&data, &p, &f, &mut out).unwrap();
+            let err = rel_err(common::column(&out).as_ref(), common::column(&expected).as_ref());
+            assert!(err <= 1e-12, "{name}: JᵀF error {err:e}");
+        }
+    }
+}
