@@ -1,0 +1,160 @@
+//! Tension distribution over a whole arm: every joint's feasible interval and the tensions at
+//! chosen tension levels (eq. 22–23, spec §4), for the decoupled and the routed models.
+//!
+//! # Math
+//! Joint `i`'s DOF are balanced when `−Σ_c J_c[c, 2i..2i+2] f_c = T0[2i..2i+2]`. Its own three
+//! cables see the torque `τ_i = T0_i + Σ_{c distal} J_c[c, 2i..2i+2] f_c`, where the sum runs
+//! over the cables of joints beyond `i` that cross it (none in the decoupled model). So the
+//! joints are solved from the tip to the base: the tensions chosen at distal joints are known
+//! torques at proximal ones. With no crossing cable the joints are independent and are solved
+//! from the base, so that an infeasible load names the joint nearest the base.
+//!
+//! Supported routings: three cables per universal joint, cables ordered by joint, no cable
+//! changing length with the DOF of a joint beyond its own. Others are
+//! [`StaticsError::UnsupportedRouting`].
+
+use faer::MatRef;
+use nalgebra::{Matrix3x2, Vector2};
+
+use crate::error::StaticsError;
+use crate::interval::{TensionInterval, TensionLimits, tension_interval};
+
+/// How the cables of a routing map onto the joints: three per universal joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CableLayout {
+    joints: usize,
+    crossing: bool,
+}
+
+impl CableLayout {
+    /// Check that a cable Jacobian (m × 2n) with `cable_joint[c]` the universal joint cable `c`
+    /// drives fits the solver: 3 cables per joint in joint order, none reaching beyond its own
+    /// joint. `crossing` records whether any cable also crosses proximal joints (routed).
+    ///
+    /// # Errors
+    /// [`StaticsError::UnsupportedRouting`] saying what does not fit.
+    pub fn new(
+        jacobian: MatRef<'_, f64>,
+        cable_joint: &[usize],
+    ) -> Result<CableLayout, StaticsError> {
+        let unsupported = |reason: String| StaticsError::UnsupportedRouting { reason };
+        let (m, dof) = (jacobian.nrows(), jacobian.ncols());
+        if dof % 2 != 0 {
+            return Err(unsupported(format!("{dof} DOF is not a chain of 2-DOF universal joints")));
+        }
+        let joints = dof / 2;
+        if m != cable_joint.len() {
+            return Err(StaticsError::DimensionMismatch {
+                what: "cable joints",
+                expected: m,
+                got: cable_joint.len(),
+            });
+        }
+        if m != 3 * joints {
+            return Err(unsupported(format!(
+                "{m} cables for {joints} joints; the closed-form solver needs 3 per joint"
+            )));
+        }
+        for (c, &joint) in cable_joint.iter().enumerate() {
+            if joint != c / 3 {
+                return Err(unsupported(format!(
+                    "cable {c} drives joint {}; expected cables ordered by joint, 3 each",
+                    joint + 1
+                )));
+            }
+        }
+        let mut crossing = false;
+        for c in 0..m {
+            let own = c / 3;
+            for col in 0..dof {
+                if jacobian[(c, col)] != 0.0 {
+                    if col / 2 > own {
+                        return Err(unsupported(format!(
+                            "cable {c} of joint {} changes length with joint {}, beyond its own",
+                            own + 1,
+                            col / 2 + 1
+                        )));
+                    }
+                    if col / 2 < own {
+                        crossing = true;
+                    }
+                }
+            }
+        }
+        Ok(CableLayout { joints, crossing })
+    }
+
+    /// Number of universal joints.
+    pub fn joints(&self) -> usize {
+        self.joints
+    }
+
+    /// Whether some cable also crosses (and loads) proximal joints: the routed model.
+    pub fn crossing(&self) -> bool {
+        self.crossing
+    }
+}
+
+/// Every joint's feasible interval and the tensions at the given tension levels.
+///
+/// `t0` (2n) are the torques the cables must supply (e.g. from
+/// [`crate::equilibrium_torques`]); `levels[i] ∈ [0, 1]` places joint `i` on its interval.
+/// Writes `intervals` (n) and `tensions` (3n, N). No allocation.
+///
+/// # Errors
+/// [`StaticsError::Infeasible`] naming the first joint that fails (solving order above),
+/// [`StaticsError::InvalidLevel`], [`StaticsError::DimensionMismatch`].
+pub fn distribute_tensions(
+    layout: &CableLayout,
+    jacobian: MatRef<'_, f64>,
+    limits: TensionLimits,
+    t0: &[f64],
+    levels: &[f64],
+    intervals: &mut [TensionInterval],
+    tensions: &mut [f64],
+) -> Result<(), StaticsError> {
+    let n = layout.joints;
+    let sizes = [
+        ("cable Jacobian rows", 3 * n, jacobian.nrows()),
+        ("cable Jacobian columns", 2 * n, jacobian.ncols()),
+        ("equilibrium torques T0", 2 * n, t0.len()),
+        ("tension levels", n, levels.len()),
+        ("tension intervals", n, intervals.len()),
+        ("tensions", 3 * n, tensions.len()),
+    ];
+    for (what, expected, got) in sizes {
+        if expected != got {
+            return Err(StaticsError::DimensionMismatch { what, expected, got });
+        }
+    }
+    for (joint, &level) in levels.iter().enumerate() {
+        if !(0.0..=1.0).contains(&level) {
+            return Err(StaticsError::InvalidLevel { joint, level });
+        }
+    }
+    let mut solve = |i: usize, tensions: &mut [f64]| -> Result<(), StaticsError> {
+        let mut tau = Vector2::new(t0[2 * i], t0[2 * i + 1]);
+        if layout.crossing {
+            for c in 3 * (i + 1)..3 * n {
+                tau[0] += jacobian[(c, 2 * i)] * tensions[c];
+                tau[1] += jacobian[(c, 2 * i + 1)] * tensions[c];
+            }
+        }
+        let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);
+        let interval = tension_interval(i, &block, &tau, limits)?;
+        let f = interval.tensions_at_level(levels[i]);
+        tensions[3 * i..3 * i + 3].copy_from_slice(f.as_slice());
+        intervals[i] = interval;
+        Ok(())
+    };
+    if layout.crossing {
+        for i in (0..n).rev() {
+            solve(i, tensions)?;
+        }
+    } else {
+        for i in 0..n {
+            solve(i, tensions)?;
+        }
+    }
+    Ok(())
+}

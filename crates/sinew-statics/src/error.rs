@@ -1,0 +1,101 @@
+//! The one error type of this crate.
+
+/// Why a joint's cables cannot hold its torque.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum InfeasibleReason {
+    /// The joint's cable Jacobian block has rank < 2: the cables cannot produce some torque.
+    RankDeficient,
+    /// The null space of `J_cᵀ` has no strictly positive direction: the cables cannot all be
+    /// tensioned together without unbalancing the joint (lost force closure). `null` is the
+    /// unit null direction found.
+    NoForceClosure {
+        /// Unit null direction of `J_cᵀ`.
+        null: [f64; 3],
+    },
+    /// Every balancing tension vector leaves some cable outside `[f_min, f_max]`: the limits
+    /// would need `λ ≥ lambda_min` and `λ ≤ lambda_max` with `lambda_min > lambda_max`.
+    OutsideLimits {
+        /// Least `λ` that keeps every cable at or above `f_min`.
+        lambda_min: f64,
+        /// Greatest `λ` that keeps every cable at or below `f_max`.
+        lambda_max: f64,
+    },
+}
+
+impl std::fmt::Display for InfeasibleReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            InfeasibleReason::RankDeficient => write!(f, "its cable Jacobian has rank < 2"),
+            InfeasibleReason::NoForceClosure { null } => write!(
+                f,
+                "its cables have lost force closure (null direction [{:.3}, {:.3}, {:.3}] is not positive)",
+                null[0], null[1], null[2]
+            ),
+            InfeasibleReason::OutsideLimits { lambda_min, lambda_max } => write!(
+                f,
+                "no tensions within the limits hold the torque (λ ≥ {lambda_min:.4} and λ ≤ {lambda_max:.4})"
+            ),
+        }
+    }
+}
+
+/// Everything that can go wrong in the statics.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum StaticsError {
+    /// A joint's cables cannot hold its torque within the tension limits: the typed outcome of
+    /// an infeasible load.
+    #[error("joint {} cannot hold torque [{:.4}, {:.4}] N m with tensions in [{}, {}] N: {reason}", .joint + 1, .torque[0], .torque[1], .limits[0], .limits[1])]
+    Infeasible {
+        /// Universal joint index (0-based; the message counts from 1, as the paper does).
+        joint: usize,
+        /// The torque the joint's own cables must hold, N m.
+        torque: [f64; 2],
+        /// `[f_min, f_max]`, N.
+        limits: [f64; 2],
+        /// Why.
+        reason: InfeasibleReason,
+    },
+    /// A torque with a NaN or infinite component.
+    #[error("joint {}: torque [{}, {}] is not finite", .joint + 1, .torque[0], .torque[1])]
+    NonFiniteTorque {
+        /// Universal joint index (0-based).
+        joint: usize,
+        /// The torque.
+        torque: [f64; 2],
+    },
+    /// A tension level outside `[0, 1]` (or NaN).
+    #[error("joint {}: tension level {level} is outside [0, 1]", .joint + 1)]
+    InvalidLevel {
+        /// Universal joint index (0-based).
+        joint: usize,
+        /// The level passed.
+        level: f64,
+    },
+    /// A routing that is not three cables per universal joint (each cable driving one joint).
+    #[error("unsupported routing: {reason}")]
+    UnsupportedRouting {
+        /// What does not fit.
+        reason: String,
+    },
+    /// An input of the wrong size.
+    #[error("{what}: expected {expected} entries, got {got}")]
+    DimensionMismatch {
+        /// What was passed.
+        what: &'static str,
+        /// The size needed.
+        expected: usize,
+        /// The size passed.
+        got: usize,
+    },
+    /// A wrench with a NaN or infinite component.
+    #[error("wrench {wrench:?} is not finite")]
+    NonFiniteWrench {
+        /// The wrench.
+        wrench: [f64; 6],
+    },
+    /// An error of the robot model (sizes, workspace).
+    #[error(transparent)]
+    Robot(#[from] sinew_robot::RobotError),
+}

@@ -1,0 +1,135 @@
+//! The feasible tension interval of one 3-cable, 2-DOF joint, in closed form (eq. 22–23).
+//!
+//! # Math
+//! The joint's cables hold a torque `τ` (2) when `τ + J_cᵀ f = 0` (eq. 23, `P`), with `J_c`
+//! the 3 × 2 block of the cable Jacobian (rows: the joint's cables, columns: its two DOF).
+//! `P` is the line `f = f_p + λ n` with
+//!
+//! ```text
+//! f_p = −J_c (J_cᵀ J_c)⁻¹ τ          (the minimum-norm solution)
+//! n   = J_c[:,0] × J_c[:,1] / |…|    (spans null(J_cᵀ), oriented so that n > 0)
+//! ```
+//!
+//! The cables are in force closure when `n` can be chosen strictly positive; then
+//! `Ω ∩ P` (eq. 22) is the interval `λ ∈ [max_k (f_min − f_p,k)/n_k, min_k (f_max − f_p,k)/n_k]`,
+//! and every tension rises with `λ`, so `λ_min` is the end of least total tension (level
+//! `s = 0`) and `λ_max` that of most (`s = 1`).
+
+use nalgebra::{Matrix3x2, Vector2, Vector3};
+
+use crate::error::{InfeasibleReason, StaticsError};
+
+/// A component of the null direction below this fraction of its norm counts as zero: the
+/// cables have lost force closure (one tension cannot be changed without losing balance).
+pub const FORCE_CLOSURE_TOLERANCE: f64 = 1e-9;
+
+/// `det(J_cᵀ J_c)` below this fraction of `(trace)²` counts as a rank-deficient cable Jacobian.
+pub const RANK_TOLERANCE: f64 = 1e-12;
+
+/// Tension limits of a joint's cables, N.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TensionLimits {
+    /// Least tension, N (cables must stay taut).
+    pub f_min: f64,
+    /// Greatest tension, N.
+    pub f_max: f64,
+}
+
+/// The feasible set `Λ = Ω ∩ P` of one joint: `f(λ) = f_p + λ n`, `λ ∈ [λ_min, λ_max]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TensionInterval {
+    /// Universal joint index (0-based).
+    pub joint: usize,
+    /// The minimum-norm tensions that hold the torque, `f_p` (N; may lie outside the limits).
+    pub particular: Vector3<f64>,
+    /// Unit null direction of `J_cᵀ`, every component positive.
+    pub null: Vector3<f64>,
+    /// Lower end of the interval (least total tension).
+    pub lambda_min: f64,
+    /// Upper end of the interval (most total tension).
+    pub lambda_max: f64,
+}
+
+impl TensionInterval {
+    /// Tensions at a point `λ` of the line `P`, N.
+    pub fn tensions(&self, lambda: f64) -> Vector3<f64> {
+        self.particular + lambda * self.null
+    }
+
+    /// `λ` at tension level `s ∈ [0, 1]` (0: least total tension, 1: most).
+    pub fn lambda_at_level(&self, s: f64) -> f64 {
+        self.lambda_min + s * (self.lambda_max - self.lambda_min)
+    }
+
+    /// Tensions at tension level `s ∈ [0, 1]`, N.
+    pub fn tensions_at_level(&self, s: f64) -> Vector3<f64> {
+        self.tensions(self.lambda_at_level(s))
+    }
+
+    /// Tensions at both ends, `(at λ_min, at λ_max)`, N.
+    pub fn ends(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.tensions(self.lambda_min), self.tensions(self.lambda_max))
+    }
+
+    /// Width of the interval, `λ_max − λ_min` (≥ 0).
+    pub fn width(&self) -> f64 {
+        self.lambda_max - self.lambda_min
+    }
+}
+
+/// The feasible tension interval of joint `joint` for the torque `tau` (eq. 22–23).
+///
+/// `jacobian` is the joint's 3 × 2 block of `J_c` (rows: its cables, columns: its two DOF);
+/// `tau` the torque its cables must hold (`τ = −J_cᵀ f`). `O(1)`, no allocation.
+///
+/// # Errors
+/// [`StaticsError::Infeasible`] naming the joint and the reason: a rank-deficient `J_c`, lost
+/// force closure, or a torque that no tensions within the limits hold.
+pub fn tension_interval(
+    joint: usize,
+    jacobian: &Matrix3x2<f64>,
+    tau: &Vector2<f64>,
+    limits: TensionLimits,
+) -> Result<TensionInterval, StaticsError> {
+    let infeasible = |reason| StaticsError::Infeasible {
+        joint,
+        torque: [tau[0], tau[1]],
+        limits: [limits.f_min, limits.f_max],
+        reason,
+    };
+    if !(tau[0].is_finite() && tau[1].is_finite()) {
+        return Err(StaticsError::NonFiniteTorque { joint, torque: [tau[0], tau[1]] });
+    }
+    let jtj = jacobian.transpose() * jacobian;
+    let det = jtj[(0, 0)] * jtj[(1, 1)] - jtj[(0, 1)] * jtj[(1, 0)];
+    let trace = jtj[(0, 0)] + jtj[(1, 1)];
+    if !(det > RANK_TOLERANCE * trace * trace) {
+        return Err(infeasible(InfeasibleReason::RankDeficient));
+    }
+    // (JᵀJ)⁻¹ τ by the 2 × 2 adjugate.
+    let y = Vector2::new(
+        jtj[(1, 1)] * tau[0] - jtj[(0, 1)] * tau[1],
+        -jtj[(1, 0)] * tau[0] + jtj[(0, 0)] * tau[1],
+    ) / det;
+    let particular = -(jacobian * y);
+    let c0: Vector3<f64> = jacobian.column(0).into_owned();
+    let c1: Vector3<f64> = jacobian.column(1).into_owned();
+    let mut null = c0.cross(&c1);
+    null /= null.norm();
+    if null.sum() < 0.0 {
+        null = -null;
+    }
+    if null.min() <= FORCE_CLOSURE_TOLERANCE {
+        return Err(infeasible(InfeasibleReason::NoForceClosure { null: null.into() }));
+    }
+    let mut lambda_min = f64::NEG_INFINITY;
+    let mut lambda_max = f64::INFINITY;
+    for k in 0..3 {
+        lambda_min = lambda_min.max((limits.f_min - particular[k]) / null[k]);
+        lambda_max = lambda_max.min((limits.f_max - particular[k]) / null[k]);
+    }
+    if lambda_min > lambda_max {
+        return Err(infeasible(InfeasibleReason::OutsideLimits { lambda_min, lambda_max }));
+    }
+    Ok(TensionInterval { joint, particular, null, lambda_min, lambda_max })
+}

@@ -1,0 +1,57 @@
+//! # sinew-statics
+//!
+//! The statics of a cable-driven hyper-redundant manipulator (paper section II, IV.A):
+//!
+//! - cable-joint statics (eq. 5): `τ = −J_cᵀ f` ([`cable_torques`]);
+//! - the feasible tension interval of a 3-cable, 2-DOF joint in closed form (eq. 22–23,
+//!   [`tension_interval`]) and over a whole arm, decoupled or routed ([`distribute_tensions`]);
+//! - joint-end statics (eq. 6–9): `T0 = T_g + J_xᵀ F0` ([`equilibrium_torques`]) and
+//!   `K_W = ∂T0/∂Q` ([`equilibrium_torque_derivative`]).
+//!
+//! Infeasible loads and lost force closure are typed outcomes ([`StaticsError::Infeasible`]
+//! with an [`InfeasibleReason`]) naming the joint — never a NaN, never a panic.
+#![deny(missing_docs)]
+
+mod distribution;
+mod error;
+mod interval;
+mod joint_end;
+
+pub use distribution::{CableLayout, distribute_tensions};
+pub use error::{InfeasibleReason, StaticsError};
+pub use interval::{
+    FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, tension_interval,
+};
+pub use joint_end::{JointEndData, equilibrium_torque_derivative, equilibrium_torques};
+
+use faer::MatRef;
+
+/// Cable-joint statics (eq. 5): `τ = −J_cᵀ f`, the generalized force the cables put on the
+/// joints (N m). `tau` has length dof, `tensions` length m. No allocation.
+///
+/// # Errors
+/// [`StaticsError::DimensionMismatch`].
+pub fn cable_torques(
+    jacobian: MatRef<'_, f64>,
+    tensions: &[f64],
+    tau: &mut [f64],
+) -> Result<(), StaticsError> {
+    if tensions.len() != jacobian.nrows() {
+        return Err(StaticsError::DimensionMismatch {
+            what: "tensions",
+            expected: jacobian.nrows(),
+            got: tensions.len(),
+        });
+    }
+    if tau.len() != jacobian.ncols() {
+        return Err(StaticsError::DimensionMismatch {
+            what: "cable torques",
+            expected: jacobian.ncols(),
+            got: tau.len(),
+        });
+    }
+    for (j, t) in tau.iter_mut().enumerate() {
+        *t = -(0..tensions.len()).map(|c| jacobian[(c, j)] * tensions[c]).sum::<f64>();
+    }
+    Ok(())
+}

@@ -1,0 +1,107 @@
+//! The closed-form tension interval of one joint: equilibrium, exact ends, typed failures.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use nalgebra::{Matrix3x2, Vector2, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use sinew_statics::{InfeasibleReason, StaticsError, TensionLimits, tension_interval};
+
+const LIMITS: TensionLimits = TensionLimits { f_min: 20.0, f_max: 600.0 };
+
+/// A cable Jacobian block of three cables through holes at radius ρ, 120° apart, for a joint
+/// bent by small angles: rows ≈ ∂L/∂q = [ρ sin θ_k, −ρ cos θ_k] plus a perturbation.
+fn joint_block(rng: &mut ChaCha8Rng) -> Matrix3x2<f64> {
+    let rho = rng.random_range(0.01..0.03);
+    let theta0 = rng.random_range(0.0..std::f64::consts::TAU);
+    Matrix3x2::from_fn(|k, c| {
+        let theta = theta0 + k as f64 * std::f64::consts::TAU / 3.0;
+        let base = if c == 0 { rho * theta.sin() } else { -rho * theta.cos() };
+        base * (1.0 + rng.random_range(-0.2..0.2))
+    })
+}
+
+#[test]
+fn every_level_balances_the_torque_and_the_ends_are_exact() {
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let mut checked = 0;
+    for _ in 0..1000 {
+        let jacobian = joint_block(&mut rng);
+        let tau = Vector2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
+        let Ok(interval) = tension_interval(0, &jacobian, &tau, LIMITS) else { continue };
+        checked += 1;
+        assert!(interval.lambda_min <= interval.lambda_max);
+        assert!(interval.null.min() > 0.0);
+        for s in [0.0, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0] {
+            let f = interval.tensions_at_level(s);
+            let residual = (tau + jacobian.transpose() * f).norm();
+            assert!(residual <= 1e-9, "residual {residual:e} at level {s}");
+            for k in 0..3 {
+                assert!(f[k] >= LIMITS.f_min - 1e-9 && f[k] <= LIMITS.f_max + 1e-9, "f = {f:?}");
+            }
+        }
+        let (low, high) = interval.ends();
+        let on_limit = |f: Vector3<f64>| {
+            f.iter().any(|&x| (x - LIMITS.f_min).abs() <= 1e-9 || (x - LIMITS.f_max).abs() <= 1e-9)
+        };
+        assert!(on_limit(low) && on_limit(high), "ends {low:?} {high:?} not on a limit");
+        // The lower end has the least total tension.
+        assert!(low.sum() <= high.sum());
+    }
+    assert!(checked > 500, "only {checked} of 1000 random joints were feasible");
+}
+
+#[test]
+fn a_torque_beyond_the_limits_is_infeasible_and_names_the_joint() {
+    let mut rng = ChaCha8Rng::seed_from_u64(22);
+    let jacobian = joint_block(&mut rng);
+    let tau = Vector2::new(100.0, 0.0);
+    let err = tension_interval(3, &jacobian, &tau, LIMITS).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            StaticsError::Infeasible {
+                joint: 3,
+                reason: InfeasibleReason::OutsideLimits { .. },
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    assert!(err.to_string().starts_with("joint 4 cannot hold torque"), "{err}");
+}
+
+#[test]
+fn lost_force_closure_is_a_typed_outcome() {
+    // Null direction of Jᵀ along [1, −1, 0]: cables 1 and 2 pull the same way.
+    let jacobian = Matrix3x2::new(0.02, 0.0, 0.02, 0.0, 0.0, 0.02);
+    let err = tension_interval(0, &jacobian, &Vector2::new(0.1, 0.1), LIMITS).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            StaticsError::Infeasible { reason: InfeasibleReason::NoForceClosure { .. }, .. }
+        ),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("force closure"), "{err}");
+}
+
+#[test]
+fn a_rank_deficient_block_is_a_typed_outcome() {
+    let jacobian = Matrix3x2::new(0.02, 0.04, -0.01, -0.02, -0.01, -0.02);
+    let err = tension_interval(1, &jacobian, &Vector2::new(0.1, 0.1), LIMITS).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            StaticsError::Infeasible { joint: 1, reason: InfeasibleReason::RankDeficient, .. }
+        ),
+        "{err:?}"
+    );
+}
+
+#[test]
+fn a_nan_torque_is_an_error_not_a_nan() {
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let jacobian = joint_block(&mut rng);
+    let err = tension_interval(0, &jacobian, &Vector2::new(f64::NAN, 0.0), LIMITS).unwrap_err();
+    assert!(matches!(err, StaticsError::NonFiniteTorque { .. }), "{err:?}");
+}
