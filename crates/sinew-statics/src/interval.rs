@@ -103,7 +103,9 @@ pub fn tension_interval(
     let jtj = jacobian.transpose() * jacobian;
     let det = jtj[(0, 0)] * jtj[(1, 1)] - jtj[(0, 1)] * jtj[(1, 0)];
     let trace = jtj[(0, 0)] + jtj[(1, 1)];
-    if !(det > RANK_TOLERANCE * trace * trace) {
+    // Written so that a NaN determinant also counts as rank-deficient.
+    let full_rank = det > RANK_TOLERANCE * trace * trace;
+    if !full_rank {
         return Err(infeasible(InfeasibleReason::RankDeficient));
     }
     // (JᵀJ)⁻¹ τ by the 2 × 2 adjugate.
