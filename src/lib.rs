@@ -8,8 +8,11 @@
 //!
 //! - [`robot`]: URDF → immutable chain model, kinematics, Jacobians and their derivatives,
 //!   gravity torques (`sinew-robot`).
+//! - [`routing`]: cables as polylines through disc holes — lengths, cable Jacobian `J_c`, each
+//!   cable's Hessian and the cable stiffness `K_l`, decoupled and routed (`sinew-routing`).
 //!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
 
 pub use sinew_robot as robot;
+pub use sinew_routing as routing;

@@ -57,6 +57,11 @@ impl RobotData {
         }
     }
 
+    /// Number of joints the workspace is sized for.
+    pub fn dof(&self) -> usize {
+        self.dof
+    }
+
     /// Pose of body `b` in the base frame, as of the last [`Robot::forward_kinematics`].
     pub fn body_pose(&self, b: usize) -> Option<&IsometryMatrix3<f64>> {
         self.o_m_body.get(b)

@@ -271,13 +271,6 @@ pub fn end_stiffness(
     for i in 0..6 {
         k_x[(i, i)] = 1.0;
     }
-    lu::solve::solve_in_place(
-        data.lu6.as_ref(),
-        data.lu6.as_ref(),
-        perm,
-        k_x,
-        Par::Seq,
-        stack,
-    );
+    lu::solve::solve_in_place(data.lu6.as_ref(), data.lu6.as_ref(), perm, k_x, Par::Seq, stack);
     Ok(())
 }

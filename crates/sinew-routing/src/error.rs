@@ -1,0 +1,276 @@
+//! The one error type of this crate.
+
+use std::path::PathBuf;
+
+use sinew_robot::RobotError;
+
+/// Everything that can go wrong while loading a routing or evaluating it at a configuration.
+///
+/// Load-time variants name the routing file (`file`, `<string>` or `<generated …>` when not read
+/// from disk), the cable at fault (its name) and the field at fault, spelled as in the file
+/// (`cable[2].holes[1].link`, `pattern.distal_discs[3]`, `material.diameter`), so that a message
+/// read on its own says what to fix.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RoutingError {
+    /// A file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML, or does not have the routing file's shape (unknown key,
+    /// missing key, wrong type). The message comes from the TOML parser and gives the line.
+    #[error("{file}: invalid routing file: {message}")]
+    Parse {
+        /// The routing file.
+        file: String,
+        /// What the TOML parser said.
+        message: String,
+    },
+    /// The file gives both a `[pattern]` and `[[cable]]` entries, or neither.
+    #[error("{file}: {message}")]
+    CableForm {
+        /// The routing file.
+        file: String,
+        /// What is wrong.
+        message: &'static str,
+    },
+    /// The robot does not consist of universal joints (an even number of revolute joints).
+    #[error(
+        "{file}: robot `{robot}` has {dof} revolute joints; a routing needs pairs (universal joints)"
+    )]
+    NotUniversal {
+        /// The routing file.
+        file: String,
+        /// The robot.
+        robot: String,
+        /// Its number of revolute joints.
+        dof: usize,
+    },
+    /// A hole (or disc) names a link that the robot does not have.
+    #[error("{file}: cable `{cable}`: {field} = `{link}`: the robot has no such link")]
+    UnknownLink {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// The field naming the link.
+        field: String,
+        /// The missing link.
+        link: String,
+    },
+    /// A hole lies on a link that is not on the cable's chain: the bodies from the base to the
+    /// cable's anchor (its last hole). A cable cannot pass beyond the disc that it ends on.
+    #[error(
+        "{file}: cable `{cable}`: {field} = `{link}` (body {body}) is not on the cable's chain, the bodies 0..={anchor_body} from the base to its anchor"
+    )]
+    HoleOffChain {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// The field naming the link.
+        field: String,
+        /// The link.
+        link: String,
+        /// Its body.
+        body: usize,
+        /// The body of the cable's anchor.
+        anchor_body: usize,
+    },
+    /// A cable with fewer than two holes has no segment.
+    #[error("{file}: cable `{cable}`: {field} has {holes} hole(s); a cable needs at least 2")]
+    TooFewHoles {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// The field listing the holes.
+        field: String,
+        /// How many holes it has.
+        holes: usize,
+    },
+    /// Two cables share a name.
+    #[error("{file}: cable `{cable}` is defined twice ({field})")]
+    DuplicateCable {
+        /// The routing file.
+        file: String,
+        /// The repeated name.
+        cable: String,
+        /// The second definition.
+        field: String,
+    },
+    /// A cable's `joint` is not a universal joint of the robot, or its anchor does not sit on
+    /// the distal side of that joint, or none of its holes lies proximal to it.
+    #[error("{file}: cable `{cable}`: {field}: {message}")]
+    WrongJoint {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// The field at fault (`cable[i].joint` or the anchor's link).
+        field: String,
+        /// What is wrong, with the numbers.
+        message: String,
+    },
+    /// A segment between two consecutive holes has (near-)zero or non-finite length at Q = 0:
+    /// its direction, and so its derivatives, would be undefined.
+    #[error(
+        "{file}: cable `{cable}`: segment {segment} ({from} → {to}) has length {length} m at Q = 0; need a finite length ≥ {min} m"
+    )]
+    ZeroLengthSegment {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// Segment index within the cable (segment `s` joins holes `s` and `s + 1`).
+        segment: usize,
+        /// The field of its first hole.
+        from: String,
+        /// The field of its second hole.
+        to: String,
+        /// Its length at Q = 0, m.
+        length: f64,
+        /// The least length accepted, m ([`crate::MIN_SEGMENT_LENGTH`]).
+        min: f64,
+    },
+    /// The cable material is not physical: a non-positive or non-finite Young's modulus,
+    /// diameter or area (or neither/both of diameter and area). It applies to every cable.
+    #[error("{file}: {field} = {value}: {message} (applies to every cable)")]
+    InvalidMaterial {
+        /// The routing file.
+        file: String,
+        /// The field (`material.youngs_modulus`, `material.diameter`, `material.area`).
+        field: &'static str,
+        /// The value read (NaN when absent).
+        value: f64,
+        /// What is wrong.
+        message: &'static str,
+    },
+    /// The tension limits `[f_min, f_max]` do not satisfy `0 ≤ f_min < f_max` (finite).
+    #[error(
+        "{file}: tension_limits = [{f_min}, {f_max}] N: need finite 0 ≤ f_min < f_max (applies to every cable)"
+    )]
+    InvalidTensionLimits {
+        /// The routing file.
+        file: String,
+        /// Lower limit read, N.
+        f_min: f64,
+        /// Upper limit read, N.
+        f_max: f64,
+    },
+    /// A number in the file is out of its range (a NaN coordinate, a negative free length, a
+    /// zero radius …). `cable` is empty when the field is not a cable's own.
+    #[error("{file}: {}{field} = {value}: {expected}", cable_prefix(.cable))]
+    InvalidValue {
+        /// The routing file.
+        file: String,
+        /// The cable, or empty when the field concerns several cables.
+        cable: String,
+        /// The field.
+        field: String,
+        /// The value read.
+        value: f64,
+        /// What the value must be.
+        expected: &'static str,
+    },
+    /// A per-joint list of the pattern (discs, radii, free lengths) whose length is not the
+    /// number of universal joints.
+    #[error("{file}: {field} has {got} entries; the robot has {expected} universal joints")]
+    PatternSize {
+        /// The routing file.
+        file: String,
+        /// The list.
+        field: String,
+        /// Number of universal joints.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// At a configuration, a segment became (nearly) zero-length: the cable's direction there is
+    /// undefined. Never a NaN: this error instead.
+    #[error(
+        "cable `{cable}`: segment {segment} has length {length} m at this configuration (< {min} m); its direction is undefined"
+    )]
+    DegenerateSegment {
+        /// The cable.
+        cable: String,
+        /// Segment index within the cable.
+        segment: usize,
+        /// Its length, m.
+        length: f64,
+        /// The least length accepted, m.
+        min: f64,
+    },
+    /// The routing was built for another robot (or the robot workspace for another robot).
+    #[error(
+        "routing was built for robot `{routing_robot}` ({routing_dof} joints), not for `{robot}` ({dof} joints)"
+    )]
+    RobotMismatch {
+        /// The robot the routing was built for.
+        routing_robot: String,
+        /// Its joints.
+        routing_dof: usize,
+        /// The robot passed.
+        robot: String,
+        /// Its joints.
+        dof: usize,
+    },
+    /// A workspace ([`crate::RoutingData`] or `RobotData`) sized for another routing or robot.
+    #[error("{what} was sized for {got}, the routing needs {expected}")]
+    WorkspaceMismatch {
+        /// Which workspace and which size.
+        what: &'static str,
+        /// The size the routing needs.
+        expected: usize,
+        /// The size it has.
+        got: usize,
+    },
+    /// A caller's buffer has the wrong size.
+    #[error("{what}: expected {expected} entries, got {got}")]
+    DimensionMismatch {
+        /// What was passed.
+        what: &'static str,
+        /// The size needed.
+        expected: usize,
+        /// The size passed.
+        got: usize,
+    },
+    /// A cable index out of range.
+    #[error("cable index {cable} is out of range: the routing has {cables} cables")]
+    NoSuchCable {
+        /// The index passed.
+        cable: usize,
+        /// How many cables there are.
+        cables: usize,
+    },
+    /// A quantity was asked for that the last evaluation did not compute (e.g. Hessians after
+    /// an evaluation with [`crate::Order::Jacobian`]).
+    #[error("{what} not computed: evaluate with at least Order::{needed:?}")]
+    NotComputed {
+        /// What was asked for.
+        what: &'static str,
+        /// The evaluation order that computes it.
+        needed: crate::Order,
+    },
+    /// Serializing the expanded routing failed.
+    #[error("cannot serialize the routing: {message}")]
+    Serialize {
+        /// What the serializer said.
+        message: String,
+    },
+    /// An error of the robot model (kinematics, workspace, configuration).
+    #[error(transparent)]
+    Robot(#[from] RobotError),
+}
+
+fn cable_prefix(cable: &str) -> String {
+    if cable.is_empty() { String::new() } else { format!("cable `{cable}`: ") }
+}
+
+/// Result with [`RoutingError`].
+pub type Result<T, E = RoutingError> = std::result::Result<T, E>;

@@ -1,0 +1,254 @@
+//! The routing file, `cables.toml`, as Rust types: what the file says, before it is checked
+//! against a robot and expanded into a [`crate::Routing`].
+//!
+//! SI units everywhere: m, rad, Pa, m², N. Two forms give the cables; a file uses exactly one.
+//!
+//! **Per-joint pattern** (three cables per universal joint):
+//!
+//! ```toml
+//! tension_limits = [20.0, 600.0]         # N, [f_min, f_max], every cable
+//! free_length = 3.0                      # m: one value, or one per universal joint
+//!
+//! [material]
+//! youngs_modulus = 12.5e9                # Pa
+//! diameter = 1.0e-3                      # m (or `area = …` in m²)
+//!
+//! [pattern]
+//! model = "decoupled"                    # or "routed"
+//! radius = 0.022                         # m: hole circle on every disc (one value or one per joint)
+//! # proximal_radius = …, distal_radius = … override `radius` per side
+//! theta0 = 1.5707963267948966            # rad, angle of cable 1 of joint 0
+//! joint_offset = 0.41887902047863906     # rad, added per joint (2π/15: 15 distinct holes)
+//! proximal_discs = ["base_link", "link1_distal"]   # one per universal joint, base first
+//! distal_discs = ["link1", "link2"]
+//! ```
+//!
+//! Cable `k` (0, 1, 2) of universal joint `i` (0-based) is named `j{i+1}c{k+1}`; its holes sit
+//! at `(ρ cos θ, ρ sin θ, 0)` in the disc frames, `θ = theta0 + 2πk/3 + i·joint_offset`.
+//! Decoupled: two holes, the proximal disc of joint `i`, then the anchor on its distal disc.
+//! Routed: the hole on the proximal disc of joint 0, then the distal and proximal discs of every
+//! joint before `i`, then the anchor on the distal disc of joint `i` (spec §2).
+//!
+//! **Explicit** (each cable an ordered list of holes, base first, the last one its anchor):
+//!
+//! ```toml
+//! [[cable]]
+//! name = "a"
+//! joint = 0                              # optional: the universal joint it drives (0-based);
+//!                                        # default (anchor body − 1) / 2
+//! free_length = 3.1                      # optional: overrides the top-level value
+//! holes = [
+//!   { link = "base_link", point = [0.022, 0.0, 0.0] },
+//!   { link = "link1", point = [0.022, 0.0, 0.0] },
+//! ]
+//! ```
+//!
+//! The elastic length of a cable is `l_c = free_length + L_c(Q = 0)` (the free length from the
+//! actuator plus the routed length), its stiffness `k_c = E·A / l_c` (eq. 13).
+
+use std::f64::consts::TAU;
+
+use serde::{Deserialize, Serialize};
+use sinew_robot::UniformChain;
+
+/// A value given once for every universal joint, or one per joint (base first).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PerJoint {
+    /// The same value for every joint.
+    Uniform(f64),
+    /// One value per universal joint.
+    Each(Vec<f64>),
+}
+
+impl PerJoint {
+    /// The value for joint `i`, if there is one.
+    pub fn get(&self, i: usize) -> Option<f64> {
+        match self {
+            PerJoint::Uniform(v) => Some(*v),
+            PerJoint::Each(values) => values.get(i).copied(),
+        }
+    }
+
+    /// Every value given (one for [`PerJoint::Uniform`]).
+    pub fn values(&self) -> &[f64] {
+        match self {
+            PerJoint::Uniform(v) => std::slice::from_ref(v),
+            PerJoint::Each(values) => values,
+        }
+    }
+}
+
+/// The cable material, common to every cable.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Young's modulus `E`, Pa.
+    pub youngs_modulus: f64,
+    /// Cable diameter, m (give exactly one of `diameter` and `area`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameter: Option<f64>,
+    /// Cross-section area `A`, m².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area: Option<f64>,
+}
+
+/// How the pattern's cables run (spec §2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PatternModel {
+    /// Each cable crosses only the joint it drives (the paper's model): `J_c` block diagonal.
+    Decoupled,
+    /// Each cable also passes through its holes on every proximal disc: `J_c` block
+    /// lower-triangular.
+    Routed,
+}
+
+/// The per-joint pattern: three cables per universal joint, holes on circles on the discs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pattern {
+    /// Decoupled or routed.
+    pub model: PatternModel,
+    /// Radius ρ of the hole circle on every disc, m (default of the two below).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<PerJoint>,
+    /// Radius on the proximal disc of each joint, m (overrides `radius`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub proximal_radius: Option<PerJoint>,
+    /// Radius on the distal disc of each joint, m (overrides `radius`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distal_radius: Option<PerJoint>,
+    /// Angle of cable 1 of joint 0 in the disc frames, rad (about z, from x).
+    #[serde(default)]
+    pub theta0: f64,
+    /// Angle added per joint, rad, so that the cables of different joints use different holes.
+    #[serde(default)]
+    pub joint_offset: f64,
+    /// The proximal disc link of each universal joint (frame `O_i`), base first.
+    pub proximal_discs: Vec<String>,
+    /// The distal disc link of each universal joint (frame `O'_i`), base first.
+    pub distal_discs: Vec<String>,
+}
+
+/// One hole of an explicit cable: a point fixed in a link's frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HoleSpec {
+    /// URDF link name.
+    pub link: String,
+    /// Coordinates in the link frame, m.
+    pub point: [f64; 3],
+}
+
+/// A cable given hole by hole.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitCable {
+    /// Unique name.
+    pub name: String,
+    /// The universal joint it drives (0-based); default `(anchor body − 1) / 2`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<usize>,
+    /// Free length from the actuator, m; default the file's `free_length` for its joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_length: Option<f64>,
+    /// The holes from the base to the anchor (the last one).
+    pub holes: Vec<HoleSpec>,
+}
+
+/// A whole routing file (`cables.toml`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoutingSpec {
+    /// `[f_min, f_max]`, N, for every cable.
+    pub tension_limits: [f64; 2],
+    /// Free length from the actuator, m: one value or one per universal joint (the cable's
+    /// joint picks it). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_length: Option<PerJoint>,
+    /// The cable material.
+    pub material: Material,
+    /// The per-joint pattern form.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<Pattern>,
+    /// The explicit form (`[[cable]]` tables).
+    #[serde(default, rename = "cable", skip_serializing_if = "Vec::is_empty")]
+    pub cables: Vec<ExplicitCable>,
+}
+
+/// Hole radius of the cdhrm5 pattern, m (see robots/cdhrm5/README.md).
+pub const CDHRM5_HOLE_RADIUS: f64 = 0.022;
+/// Angle of cable 1 of joint 0 of the cdhrm5 pattern, rad (+y).
+pub const CDHRM5_THETA0: f64 = std::f64::consts::FRAC_PI_2;
+/// Angular offset per joint of the cdhrm5 pattern, rad: 2π/15, 15 evenly spaced holes.
+pub const CDHRM5_JOINT_OFFSET: f64 = TAU / 15.0;
+/// Free length of the cdhrm5 cables from the actuator to the base disc, m.
+pub const CDHRM5_FREE_LENGTH: f64 = 3.6;
+/// Young's modulus of the cdhrm5 cables, Pa (Table I).
+pub const CDHRM5_YOUNGS_MODULUS: f64 = 12.5e9;
+/// Cable diameter of cdhrm5, m.
+pub const CDHRM5_DIAMETER: f64 = 1.0e-3;
+/// Tension limits of cdhrm5, N (Table I / section IV).
+pub const CDHRM5_TENSION_LIMITS: [f64; 2] = [20.0, 600.0];
+
+impl RoutingSpec {
+    /// Parse the text of a routing file (no check against a robot yet).
+    ///
+    /// # Errors
+    /// [`crate::RoutingError::Parse`] naming `source_name`.
+    pub fn from_toml_str(text: &str, source_name: &str) -> crate::Result<RoutingSpec> {
+        toml::from_str(text).map_err(|e| crate::RoutingError::Parse {
+            file: source_name.to_owned(),
+            message: e.to_string(),
+        })
+    }
+
+    /// The cdhrm5 routing (the values of `robots/cdhrm5/cables.toml`) for a chain generated by
+    /// [`UniformChain`]: three cables per joint on the disc links that the generator names
+    /// (`base_link` / `link{i-1}_distal` proximal, `link{i}` distal).
+    ///
+    /// Free lengths: in the decoupled model a cable's routed length is only its crossing of its
+    /// own joint, so the free length of joint `i` (0-based) adds the central channel through the
+    /// `i` links before it, `i · (d1 + d2 + link_length)`; in the routed model the routed length
+    /// already holds that run, so the free length is the same for all. Both give every cable the
+    /// same elastic length at Q = 0 as the other model.
+    pub fn for_uniform_chain(chain: &UniformChain, model: PatternModel) -> RoutingSpec {
+        let n = chain.joints;
+        let pitch = chain.d1 + chain.d2 + chain.link_length;
+        let free_length = match model {
+            PatternModel::Decoupled => {
+                PerJoint::Each((0..n).map(|i| CDHRM5_FREE_LENGTH + i as f64 * pitch).collect())
+            }
+            PatternModel::Routed => PerJoint::Uniform(CDHRM5_FREE_LENGTH),
+        };
+        RoutingSpec {
+            tension_limits: CDHRM5_TENSION_LIMITS,
+            free_length: Some(free_length),
+            material: Material {
+                youngs_modulus: CDHRM5_YOUNGS_MODULUS,
+                diameter: Some(CDHRM5_DIAMETER),
+                area: None,
+            },
+            pattern: Some(Pattern {
+                model,
+                radius: Some(PerJoint::Uniform(CDHRM5_HOLE_RADIUS)),
+                proximal_radius: None,
+                distal_radius: None,
+                theta0: CDHRM5_THETA0,
+                joint_offset: CDHRM5_JOINT_OFFSET,
+                proximal_discs: (1..=n)
+                    .map(|i| {
+                        if i == 1 {
+                            "base_link".to_owned()
+                        } else {
+                            format!("link{}_distal", i - 1)
+                        }
+                    })
+                    .collect(),
+                distal_discs: (1..=n).map(|i| format!("link{i}")).collect(),
+            }),
+            cables: Vec::new(),
+        }
+    }
+}

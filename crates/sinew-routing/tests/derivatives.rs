@@ -1,0 +1,225 @@
+//! Analytic lengths, cable Jacobian and Hessians against eq. (2) and central finite differences.
+//!
+//! Criterion: for `J_c` and for each cable's Hessian `H_c`, at 100 seeded-random configurations
+//! within the limits, `max |analytic − FD| ≤ RTOL · max |analytic|` (the error relative to the
+//! matrix's largest entry, RTOL = 1e-6, h = 1e-6). Run with `--nocapture` to see the worst
+//! errors measured.
+#![allow(clippy::unwrap_used, clippy::expect_used, non_snake_case)]
+
+mod common;
+
+use common::{H, RTOL, max_diff_and_scale, random_q, rng};
+use faer::Mat;
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use sinew_robot::{RobotData, UniformChain};
+use sinew_routing::{
+    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry, spec,
+};
+
+/// eq. (1): `T = Trans(0,0,d1) · Rot(x, q1) · Rot(y, q2) · Trans(0,0,d2)`.
+fn eq1(d1: f64, d2: f64, q1: f64, q2: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(Translation3::new(0.0, 0.0, d1), UnitQuaternion::identity())
+        * Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), q1),
+        )
+        * Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), q2),
+        )
+        * Isometry3::from_parts(Translation3::new(0.0, 0.0, d2), UnitQuaternion::identity())
+}
+
+/// eq. (2): `|r_j − T · r'_j|`, `r_j` in `O_i`, `r'_j` in `O'_i`.
+fn eq2(r: Vector3<f64>, r_prime: Vector3<f64>, T: &Isometry3<f64>) -> f64 {
+    (r - (T * Point3::from(r_prime)).coords).norm()
+}
+
+#[test]
+fn one_joint_length_is_eq_2() {
+    // A generated single joint, holes computed here from the pattern's constants.
+    let chain = UniformChain::like_cdhrm5(1);
+    let robot = chain.build().unwrap();
+    let routing = Routing::new(
+        &robot,
+        &RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled),
+        "<1>",
+    )
+    .unwrap();
+    let mut rdata = RobotData::new(&robot);
+    let mut data = RoutingData::new(&routing);
+    let rho = spec::CDHRM5_HOLE_RADIUS;
+    let mut rng = rng(1);
+    let mut worst: f64 = 0.0;
+    for _ in 0..100 {
+        let q = random_q(&robot, &mut rng);
+        compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Lengths)
+            .unwrap();
+        let T = eq1(chain.d1, chain.d2, q[0], q[1]);
+        for k in 0..3 {
+            let theta = spec::CDHRM5_THETA0 + std::f64::consts::TAU * k as f64 / 3.0;
+            let r = Vector3::new(rho * theta.cos(), rho * theta.sin(), 0.0);
+            let expected = eq2(r, r, &T);
+            let got = data.lengths().unwrap()[k];
+            worst = worst.max((got - expected).abs());
+            assert!(
+                (got - expected).abs() <= 1e-14,
+                "cable {k} at {q:?}: {got} vs eq. (2) {expected}"
+            );
+        }
+    }
+    println!("single joint: worst |L − eq. (2)| = {worst:.2e} m");
+}
+
+#[test]
+fn every_cdhrm5_joint_length_is_eq_2() {
+    // Every joint of the platform: the holes as the routing file places them (link frames of
+    // the proximal and distal discs are O_i and O'_i), T from that joint's two angles only.
+    let robot = common::cdhrm5();
+    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    let mut rdata = RobotData::new(&robot);
+    let mut data = RoutingData::new(&routing);
+    let mut rng = rng(2);
+    for _ in 0..100 {
+        let q = random_q(&robot, &mut rng);
+        compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Lengths)
+            .unwrap();
+        for (c, cable) in routing.cables().iter().enumerate() {
+            let i = cable.joint;
+            assert_eq!(cable.holes.len(), 2);
+            let T = eq1(0.015, 0.015, q[2 * i], q[2 * i + 1]);
+            let expected = eq2(cable.holes[0].point, cable.holes[1].point, &T);
+            let got = data.lengths().unwrap()[c];
+            assert!((got - expected).abs() <= 1e-14, "{}: {got} vs eq. (2) {expected}", cable.name);
+        }
+    }
+}
+
+/// Check `J_c` and every `H_c` of one case against central differences at 100 configurations.
+///
+/// The differences of `L_c` are taken segment by segment (`Σ_s (L_s(q + h) − L_s(q − h)) / 2h`,
+/// the same number as the difference of the sums without the round-off of summing a 13 m cable
+/// before subtracting); the Hessians are central differences of the analytic `J_c`, compared
+/// column by column over the rows of the cable's joints.
+fn check_against_finite_differences(name: &str, robot: &sinew_robot::Robot, routing: &Routing) {
+    let (n, m) = (robot.dof(), routing.cable_count());
+    let mut rdata = RobotData::new(robot);
+    let mut data = RoutingData::new(routing);
+    let mut plus = RoutingData::new(routing);
+    let mut minus = RoutingData::new(routing);
+    let mut fd_jacobian = Mat::<f64>::zeros(m, n);
+    let mut hessians: Vec<Mat<f64>> = (0..m).map(|_| Mat::zeros(n, n)).collect();
+    let mut hessian_scale = vec![0.0; m];
+    let mut rng = rng(7);
+    let (mut worst_j, mut worst_j_abs, mut worst_h, mut worst_h_abs) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for _ in 0..100 {
+        let q = random_q(robot, &mut rng);
+        compute_cable_geometry(routing, robot, &mut rdata, &mut data, &q, Order::Hessians).unwrap();
+        for c in 0..m {
+            data.cable_hessian(routing, c, hessians[c].as_mut()).unwrap();
+            hessian_scale[c] = max_diff_and_scale(hessians[c].as_ref(), hessians[c].as_ref()).1;
+            assert!(hessian_scale[c] > 0.0, "{name}: cable {c} has a zero Hessian");
+        }
+        let mut hessian_diff = vec![0.0f64; m];
+        let mut qh = q.clone();
+        for i in 0..n {
+            qh[i] = q[i] + H;
+            compute_cable_geometry(routing, robot, &mut rdata, &mut plus, &qh, Order::Jacobian)
+                .unwrap();
+            qh[i] = q[i] - H;
+            compute_cable_geometry(routing, robot, &mut rdata, &mut minus, &qh, Order::Jacobian)
+                .unwrap();
+            qh[i] = q[i];
+            let (sp, sm) = (plus.segment_lengths().unwrap(), minus.segment_lengths().unwrap());
+            let (jp, jm) = (plus.jacobian().unwrap(), minus.jacobian().unwrap());
+            for c in 0..m {
+                fd_jacobian[(c, i)] =
+                    routing.cables()[c].segments.clone().map(|s| (sp[s] - sm[s]) / (2.0 * H)).sum();
+                // H_c[k, i] = ∂J[c, k]/∂q_i. Outside the cable's joints (`cable.dofs`), J[c, k]
+                // and H_c[k, ·] are exact zeros at every Q (tests/structure.rs): skip them.
+                let h = &hessians[c];
+                for k in routing.cables()[c].dofs.clone() {
+                    let fd = (jp[(c, k)] - jm[(c, k)]) / (2.0 * H);
+                    hessian_diff[c] = hessian_diff[c].max((h[(k, i)] - fd).abs());
+                }
+            }
+        }
+        let (diff, scale) = max_diff_and_scale(data.jacobian().unwrap(), fd_jacobian.as_ref());
+        assert!(diff <= RTOL * scale, "{name}: J_c off by {diff:.3e} (scale {scale:.3e}) at {q:?}");
+        worst_j = worst_j.max(diff / scale);
+        worst_j_abs = worst_j_abs.max(diff);
+        for c in 0..m {
+            let (diff, scale) = (hessian_diff[c], hessian_scale[c]);
+            assert!(
+                diff <= RTOL * scale,
+                "{name}: H of cable {} off by {diff:.3e} (scale {scale:.3e}) at {q:?}",
+                routing.cables()[c].name
+            );
+            worst_h = worst_h.max(diff / scale);
+            worst_h_abs = worst_h_abs.max(diff);
+        }
+    }
+    println!(
+        "{name}: worst J_c error {worst_j:.2e} relative ({worst_j_abs:.2e} m/rad), worst Hessian error {worst_h:.2e} relative ({worst_h_abs:.2e} m/rad²)"
+    );
+}
+
+#[test]
+fn cdhrm5_decoupled_matches_finite_differences() {
+    let robot = common::cdhrm5();
+    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    check_against_finite_differences("cdhrm5 decoupled", &robot, &routing);
+}
+
+#[test]
+fn cdhrm5_routed_matches_finite_differences() {
+    let robot = common::cdhrm5();
+    let routing = common::cdhrm5_routing(&robot, PatternModel::Routed);
+    check_against_finite_differences("cdhrm5 routed", &robot, &routing);
+}
+
+#[test]
+fn chain50_decoupled_matches_finite_differences() {
+    let (robot, routing) = common::chain(50, PatternModel::Decoupled);
+    check_against_finite_differences("uniform50 decoupled", &robot, &routing);
+}
+
+#[test]
+fn chain50_routed_matches_finite_differences() {
+    let (robot, routing) = common::chain(50, PatternModel::Routed);
+    check_against_finite_differences("uniform50 routed", &robot, &routing);
+}
+
+#[test]
+fn hessians_are_symmetric_and_sum_as_weighted() {
+    for (name, robot, routing) in common::cases() {
+        let (n, m) = (robot.dof(), routing.cable_count());
+        let mut rdata = RobotData::new(&robot);
+        let mut data = RoutingData::new(&routing);
+        let mut rng = rng(11);
+        let q = random_q(&robot, &mut rng);
+        compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Hessians)
+            .unwrap();
+        let f: Vec<f64> = (0..m).map(|_| rng.random_range(20.0..600.0)).collect();
+        // Start from a non-zero matrix: add_weighted_hessians adds.
+        let start = Mat::<f64>::from_fn(n, n, |i, j| (i * n + j) as f64 * 1e-3);
+        let mut sum = start.clone();
+        data.add_weighted_hessians(&routing, &f, sum.as_mut()).unwrap();
+        let mut expected = start.clone();
+        let mut h = Mat::<f64>::zeros(n, n);
+        for c in 0..m {
+            data.cable_hessian(&routing, c, h.as_mut()).unwrap();
+            for j in 0..n {
+                for i in 0..n {
+                    assert_eq!(h[(i, j)], h[(j, i)], "{name}: H of cable {c} not symmetric");
+                    expected[(i, j)] += f[c] * h[(i, j)];
+                }
+            }
+        }
+        let (diff, scale) = max_diff_and_scale(sum.as_ref(), expected.as_ref());
+        assert!(diff <= 1e-12 * scale, "{name}: Σ f_c H_c off by {diff:.3e}");
+    }
+}
+
+use rand::Rng as _;
