@@ -10,9 +10,14 @@
 //!   gravity torques (`sinew-robot`).
 //! - [`routing`]: cables as polylines through disc holes — lengths, cable Jacobian `J_c`, each
 //!   cable's Hessian and the cable stiffness `K_l`, decoupled and routed (`sinew-routing`).
+//! - [`statics`]: cable-joint statics, tension intervals and distribution, `T0` and `∂T0/∂Q`
+//!   (`sinew-statics`).
+//! - [`stiffness`]: joint stiffness, `K_q`, end compliance and stiffness (`sinew-stiffness`).
 //!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
 
 pub use sinew_robot as robot;
 pub use sinew_routing as routing;
+pub use sinew_statics as statics;
+pub use sinew_stiffness as stiffness;

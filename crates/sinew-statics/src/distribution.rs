@@ -15,6 +15,7 @@
 
 use faer::MatRef;
 use nalgebra::{Matrix3x2, Vector2};
+use sinew_routing::Routing;
 
 use crate::error::StaticsError;
 use crate::interval::{TensionInterval, TensionLimits, tension_interval};
@@ -27,59 +28,43 @@ pub struct CableLayout {
 }
 
 impl CableLayout {
-    /// Check that a cable Jacobian (m × 2n) with `cable_joint[c]` the universal joint cable `c`
-    /// drives fits the solver: 3 cables per joint in joint order, none reaching beyond its own
-    /// joint. `crossing` records whether any cable also crosses proximal joints (routed).
+    /// Check that a routing fits the closed-form solver: 2n DOF, three cables per universal
+    /// joint in joint order, none whose length depends on a joint beyond its own. Records
+    /// whether some cable also crosses proximal joints (the routed model).
     ///
     /// # Errors
     /// [`StaticsError::UnsupportedRouting`] saying what does not fit.
-    pub fn new(
-        jacobian: MatRef<'_, f64>,
-        cable_joint: &[usize],
-    ) -> Result<CableLayout, StaticsError> {
+    pub fn new(routing: &Routing) -> Result<CableLayout, StaticsError> {
         let unsupported = |reason: String| StaticsError::UnsupportedRouting { reason };
-        let (m, dof) = (jacobian.nrows(), jacobian.ncols());
-        if dof % 2 != 0 {
+        let dof = routing.dof();
+        if !dof.is_multiple_of(2) {
             return Err(unsupported(format!("{dof} DOF is not a chain of 2-DOF universal joints")));
         }
         let joints = dof / 2;
-        if m != cable_joint.len() {
-            return Err(StaticsError::DimensionMismatch {
-                what: "cable joints",
-                expected: m,
-                got: cable_joint.len(),
-            });
-        }
-        if m != 3 * joints {
+        let cables = routing.cables();
+        if cables.len() != 3 * joints {
             return Err(unsupported(format!(
-                "{m} cables for {joints} joints; the closed-form solver needs 3 per joint"
+                "{} cables for {joints} joints; the closed-form solver needs 3 per joint",
+                cables.len()
             )));
         }
-        for (c, &joint) in cable_joint.iter().enumerate() {
-            if joint != c / 3 {
+        let mut crossing = false;
+        for (c, cable) in cables.iter().enumerate() {
+            if cable.joint != c / 3 {
                 return Err(unsupported(format!(
-                    "cable {c} drives joint {}; expected cables ordered by joint, 3 each",
-                    joint + 1
+                    "cable `{}` drives joint {}; expected 3 cables per joint, in joint order",
+                    cable.name,
+                    cable.joint + 1
                 )));
             }
-        }
-        let mut crossing = false;
-        for c in 0..m {
-            let own = c / 3;
-            for col in 0..dof {
-                if jacobian[(c, col)] != 0.0 {
-                    if col / 2 > own {
-                        return Err(unsupported(format!(
-                            "cable {c} of joint {} changes length with joint {}, beyond its own",
-                            own + 1,
-                            col / 2 + 1
-                        )));
-                    }
-                    if col / 2 < own {
-                        crossing = true;
-                    }
-                }
+            if cable.dofs.end > 2 * cable.joint + 2 {
+                return Err(unsupported(format!(
+                    "cable `{}` of joint {} changes length with joints beyond its own",
+                    cable.name,
+                    cable.joint + 1
+                )));
             }
+            crossing |= cable.dofs.start < 2 * cable.joint;
         }
         Ok(CableLayout { joints, crossing })
     }

@@ -98,4 +98,7 @@ pub enum StaticsError {
     /// An error of the robot model (sizes, workspace).
     #[error(transparent)]
     Robot(#[from] sinew_robot::RobotError),
+    /// An error of the cable geometry.
+    #[error(transparent)]
+    Routing(#[from] sinew_routing::RoutingError),
 }

@@ -6,17 +6,20 @@
 //! - the feasible tension interval of a 3-cable, 2-DOF joint in closed form (eq. 22–23,
 //!   [`tension_interval`]) and over a whole arm, decoupled or routed ([`distribute_tensions`]);
 //! - joint-end statics (eq. 6–9): `T0 = T_g + J_xᵀ F0` ([`equilibrium_torques`]) and
-//!   `K_W = ∂T0/∂Q` ([`equilibrium_torque_derivative`]).
+//!   `K_W = ∂T0/∂Q` ([`equilibrium_torque_derivative`]);
+//! - all of it for a robot and its routing in one call ([`ArmStatics`]).
 //!
 //! Infeasible loads and lost force closure are typed outcomes ([`StaticsError::Infeasible`]
 //! with an [`InfeasibleReason`]) naming the joint — never a NaN, never a panic.
 #![deny(missing_docs)]
 
+mod arm;
 mod distribution;
 mod error;
 mod interval;
 mod joint_end;
 
+pub use arm::{ArmStatics, ArmStaticsData};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use error::{InfeasibleReason, StaticsError};
 pub use interval::{
