@@ -85,11 +85,11 @@ fn every_level_balances_t0_at_random_configurations_and_loads() {
                     Err(e) => panic!("{name}: {e}"),
                 }
                 solved += 1;
-                let j_c = gdata.jacobian().unwrap();
+                // eq. 5: the cables' torque τ = −J_cᵀ f must equal T0.
+                let mut tau = vec![0.0; 2 * n];
+                cable_torques(gdata.jacobian().unwrap(), &data.tensions, &mut tau).unwrap();
                 for d in 0..2 * n {
-                    let cable_torque: f64 =
-                        (0..3 * n).map(|c| j_c[(c, d)] * data.tensions[c]).sum();
-                    worst = worst.max((data.t0[d] + cable_torque).abs());
+                    worst = worst.max((data.t0[d] - tau[d]).abs());
                 }
                 for (c, f) in data.tensions.iter().enumerate() {
                     assert!(*f >= 20.0 - 1e-9 && *f <= 600.0 + 1e-9, "{name}: cable {c} at {f} N");
