@@ -1,13 +1,13 @@
 //! The arm's statics in one call: `T0`, every joint's tension interval, the tensions at given
 //! levels (eq. 6, 22–23), for a robot and its routing.
 
-use nalgebra::{Vector3, Vector6};
+use nalgebra::{Matrix3x2, Vector2, Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
 
 use crate::distribution::{CableLayout, distribute_tensions};
-use crate::error::StaticsError;
-use crate::interval::{TensionInterval, TensionLimits};
+use crate::error::{InfeasibleReason, StaticsError};
+use crate::interval::{TensionInterval, TensionLimits, minimum_norm_tensions};
 use crate::joint_end::{JointEndData, equilibrium_torques};
 
 /// What the statics of an arm needs from its routing, checked once.
@@ -96,6 +96,63 @@ impl ArmStatics {
             &mut data.intervals,
             &mut data.tensions,
         )
+    }
+
+    /// `∂f/∂λ_i`: how every tension changes per unit of joint `i`'s null-space coordinate,
+    /// the other joints' `λ` held, balance kept (3n, into `out`). Decoupled: joint `i`'s null
+    /// direction on its own cables, zero elsewhere. Routed: the distal change loads the
+    /// proximal joints, whose minimum-norm tensions follow, from joint `i − 1` down to the
+    /// base. The map `λ → f` is affine, so this is exact. Needs a [`ArmStatics::solve`] at
+    /// the same `Q` first. No allocation.
+    ///
+    /// # Errors
+    /// [`StaticsError::DimensionMismatch`]; [`StaticsError::Infeasible`] for a rank-deficient
+    /// proximal joint.
+    pub fn tension_sensitivity(
+        &self,
+        routing_data: &RoutingData,
+        data: &ArmStaticsData,
+        joint: usize,
+        out: &mut [f64],
+    ) -> Result<(), StaticsError> {
+        let n = self.layout.joints();
+        if joint >= n {
+            return Err(StaticsError::DimensionMismatch {
+                what: "joint index",
+                expected: n,
+                got: joint,
+            });
+        }
+        if out.len() != 3 * n {
+            return Err(StaticsError::DimensionMismatch {
+                what: "tension sensitivity",
+                expected: 3 * n,
+                got: out.len(),
+            });
+        }
+        out.fill(0.0);
+        out[3 * joint..3 * joint + 3].copy_from_slice(data.intervals[joint].null.as_slice());
+        if !self.layout.crossing() {
+            return Ok(());
+        }
+        let jacobian = routing_data.jacobian()?;
+        for k in (0..joint).rev() {
+            let mut delta_tau = Vector2::zeros();
+            for c in 3 * (k + 1)..3 * n {
+                delta_tau[0] += jacobian[(c, 2 * k)] * out[c];
+                delta_tau[1] += jacobian[(c, 2 * k + 1)] * out[c];
+            }
+            let block = Matrix3x2::from_fn(|r, col| jacobian[(3 * k + r, 2 * k + col)]);
+            let delta =
+                minimum_norm_tensions(&block, &delta_tau).ok_or(StaticsError::Infeasible {
+                    joint: k,
+                    torque: [data.t0[2 * k], data.t0[2 * k + 1]],
+                    limits: [self.limits.f_min, self.limits.f_max],
+                    reason: InfeasibleReason::RankDeficient,
+                })?;
+            out[3 * k..3 * k + 3].copy_from_slice(delta.as_slice());
+        }
+        Ok(())
     }
 
     /// [`ArmStatics::solve`] at `Q`: forward kinematics and the cable Jacobian first.

@@ -77,6 +77,28 @@ impl TensionInterval {
     }
 }
 
+/// `f_p = −J_c (J_cᵀ J_c)⁻¹ τ`: the minimum-norm tensions with `τ + J_cᵀ f_p = 0` (eq. 23),
+/// `None` when the 3 × 2 block has rank < 2 (see [`RANK_TOLERANCE`]).
+pub fn minimum_norm_tensions(
+    jacobian: &Matrix3x2<f64>,
+    tau: &Vector2<f64>,
+) -> Option<Vector3<f64>> {
+    let jtj = jacobian.transpose() * jacobian;
+    let det = jtj[(0, 0)] * jtj[(1, 1)] - jtj[(0, 1)] * jtj[(1, 0)];
+    let trace = jtj[(0, 0)] + jtj[(1, 1)];
+    // Written so that a NaN determinant also counts as rank-deficient.
+    let full_rank = det > RANK_TOLERANCE * trace * trace;
+    if !full_rank {
+        return None;
+    }
+    // (JᵀJ)⁻¹ τ by the 2 × 2 adjugate.
+    let y = Vector2::new(
+        jtj[(1, 1)] * tau[0] - jtj[(0, 1)] * tau[1],
+        -jtj[(1, 0)] * tau[0] + jtj[(0, 0)] * tau[1],
+    ) / det;
+    Some(-(jacobian * y))
+}
+
 /// The feasible tension interval of joint `joint` for the torque `tau` (eq. 22–23).
 ///
 /// `jacobian` is the joint's 3 × 2 block of `J_c` (rows: its cables, columns: its two DOF);
@@ -100,20 +122,9 @@ pub fn tension_interval(
     if !(tau[0].is_finite() && tau[1].is_finite()) {
         return Err(StaticsError::NonFiniteTorque { joint, torque: [tau[0], tau[1]] });
     }
-    let jtj = jacobian.transpose() * jacobian;
-    let det = jtj[(0, 0)] * jtj[(1, 1)] - jtj[(0, 1)] * jtj[(1, 0)];
-    let trace = jtj[(0, 0)] + jtj[(1, 1)];
-    // Written so that a NaN determinant also counts as rank-deficient.
-    let full_rank = det > RANK_TOLERANCE * trace * trace;
-    if !full_rank {
+    let Some(particular) = minimum_norm_tensions(jacobian, tau) else {
         return Err(infeasible(InfeasibleReason::RankDeficient));
-    }
-    // (JᵀJ)⁻¹ τ by the 2 × 2 adjugate.
-    let y = Vector2::new(
-        jtj[(1, 1)] * tau[0] - jtj[(0, 1)] * tau[1],
-        -jtj[(1, 0)] * tau[0] + jtj[(0, 0)] * tau[1],
-    ) / det;
-    let particular = -(jacobian * y);
+    };
     let c0: Vector3<f64> = jacobian.column(0).into_owned();
     let c1: Vector3<f64> = jacobian.column(1).into_owned();
     let mut null = c0.cross(&c1);

@@ -23,7 +23,8 @@ pub use arm::{ArmStatics, ArmStaticsData};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use error::{InfeasibleReason, StaticsError};
 pub use interval::{
-    FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, tension_interval,
+    FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,
+    tension_interval,
 };
 pub use joint_end::{JointEndData, equilibrium_torque_derivative, equilibrium_torques};
 

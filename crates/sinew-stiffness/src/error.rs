@@ -46,4 +46,7 @@ pub enum StiffnessError {
     /// An error of the robot model.
     #[error(transparent)]
     Robot(#[from] sinew_robot::RobotError),
+    /// An error of the cable geometry.
+    #[error(transparent)]
+    Routing(#[from] sinew_routing::RoutingError),
 }

@@ -1,11 +1,22 @@
 //! # sinew-stiffness
 //!
 //! Joint stiffness and end stiffness of a cable-driven hyper-redundant manipulator (paper
-//! section III; spec §3, §5).
+//! section III; spec §3, §5):
+//!
+//! - joint stiffness `K = Σ f_c H_c + J_cᵀ K_l J_c` ([`joint_stiffness`]), its slope in the
+//!   tensions ([`stiffness_slope`]) and per-joint 2 × 2 blocks ([`joint_block`]);
+//! - end compliance and stiffness `C_x = J_x (K_q + K_W)⁻¹ J_xᵀ`, `K_x = C_x⁻¹`
+//!   ([`end_compliance`], [`end_stiffness`]), with unstable equilibria and rank-deficient
+//!   Jacobians as typed outcomes;
+//! - the whole pipeline `Q → K_x` for a robot and its routing ([`ArmStiffness`]).
 #![deny(missing_docs)]
 
+mod arm;
 mod end;
 mod error;
+mod joint;
 
+pub use arm::{ArmStiffness, ArmStiffnessData};
 pub use end::{EndStiffnessData, RANK_TOLERANCE, end_compliance, end_stiffness, stability_margin};
 pub use error::StiffnessError;
+pub use joint::{joint_block, joint_stiffness, stiffness_slope};

@@ -1,0 +1,192 @@
+//! Joint stiffness against finite differences of the cable torques with elastic cables
+//! (spec §3), its structure, symmetry, and the tension slope; decoupled and routed.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use faer::Mat;
+use nalgebra::{Vector3, Vector6};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use sinew_robot::{Robot, RobotData, UniformChain};
+use sinew_routing::{
+    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
+};
+use sinew_stiffness::ArmStiffness;
+
+const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+
+fn setups() -> Vec<(String, Robot, Routing)> {
+    let mut v = Vec::new();
+    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+    for file in ["cables.toml", "cables-routed.toml"] {
+        let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
+        v.push((format!("cdhrm5 {file}"), robot.clone(), routing));
+    }
+    for model in [PatternModel::Decoupled, PatternModel::Routed] {
+        let chain = UniformChain::like_cdhrm5(10);
+        let robot = chain.build().unwrap();
+        let spec = RoutingSpec::for_uniform_chain(&chain, model);
+        v.push((
+            format!("uniform10 {model:?}"),
+            robot.clone(),
+            Routing::new(&robot, &spec, "<gen>").unwrap(),
+        ));
+    }
+    v
+}
+
+/// `τ(Q) = −J_c(Q)ᵀ f(Q)` with elastic cables `f = f0 + K_l (L(Q) − L(Q0))` (spec §3).
+fn cable_torque(robot: &Robot, routing: &Routing, q: &[f64], f0: &[f64], l0: &[f64]) -> Vec<f64> {
+    let mut rdata = RobotData::new(robot);
+    let mut g = RoutingData::new(routing);
+    compute_cable_geometry(routing, robot, &mut rdata, &mut g, q, Order::Jacobian).unwrap();
+    let l = g.lengths().unwrap();
+    let j = g.jacobian().unwrap();
+    let k = routing.cable_stiffness();
+    let f: Vec<f64> = (0..f0.len()).map(|c| f0[c] + k[c] * (l[c] - l0[c])).collect();
+    (0..robot.dof()).map(|d| -(0..f.len()).map(|c| j[(c, d)] * f[c]).sum::<f64>()).collect()
+}
+
+fn max_abs(m: faer::MatRef<'_, f64>) -> f64 {
+    let mut x: f64 = 0.0;
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            x = x.max(m[(i, j)].abs());
+        }
+    }
+    x
+}
+
+#[test]
+fn k_is_minus_the_derivative_of_the_cable_torque() {
+    const H: f64 = 1e-6;
+    for (name, robot, routing) in setups() {
+        let robot = robot.with_gravity(Vector3::zeros());
+        let model = ArmStiffness::new(&routing).unwrap();
+        let mut data = model.data(&robot, &routing);
+        let n = robot.dof();
+        let joints = n / 2;
+        let mut rng = ChaCha8Rng::seed_from_u64(61);
+        let mut worst: f64 = 0.0;
+        let mut checked = 0;
+        while checked < 20 {
+            let q: Vec<f64> =
+                robot.joints().iter().map(|j| rng.random_range(j.lower..=j.upper)).collect();
+            let levels: Vec<f64> = (0..joints).map(|_| rng.random_range(0.0..0.3)).collect();
+            if model
+                .joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &levels)
+                .is_err()
+            {
+                continue;
+            }
+            checked += 1;
+            let f0 = data.tensions().to_vec();
+            let l0 = data.cables.lengths().unwrap().to_vec();
+            let mut numeric = Mat::<f64>::zeros(n, n);
+            for i in 0..n {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[i] += H;
+                qm[i] -= H;
+                let tp = cable_torque(&robot, &routing, &qp, &f0, &l0);
+                let tm = cable_torque(&robot, &routing, &qm, &f0, &l0);
+                for j in 0..n {
+                    numeric[(j, i)] = -(tp[j] - tm[j]) / (2.0 * H);
+                }
+            }
+            let k = data.k_q();
+            let err = max_abs((k.to_owned() - &numeric).as_ref()) / max_abs(k).max(1.0);
+            worst = worst.max(err);
+            // Symmetric, both parts.
+            let asym = max_abs((k.to_owned() - k.transpose()).as_ref()) / max_abs(k);
+            assert!(asym <= 1e-9, "{name}: K not symmetric ({asym:e})");
+        }
+        println!("{name}: K vs −∂τ/∂Q worst relative error {worst:.2e}");
+        assert!(worst <= 1e-6, "{name}: K error {worst:e}");
+    }
+}
+
+#[test]
+fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
+    for (name, robot, routing) in setups() {
+        let robot = robot.with_gravity(Vector3::zeros());
+        let model = ArmStiffness::new(&routing).unwrap();
+        let mut data = model.data(&robot, &routing);
+        let n = robot.dof();
+        let q: Vec<f64> = (0..n).map(|i| 0.1 * ((i as f64) * 1.7).sin()).collect();
+        model
+            .joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2])
+            .unwrap();
+        let k = data.k_q();
+        let mut off_block: f64 = 0.0;
+        for j in 0..n {
+            for i in 0..n {
+                if i / 2 != j / 2 {
+                    off_block = off_block.max(k[(i, j)].abs());
+                }
+            }
+        }
+        if name.contains("routed") || name.contains("Routed") {
+            assert!(off_block > 1e-3, "{name}: routed K_q should couple joints");
+        } else {
+            assert_eq!(off_block, 0.0, "{name}: decoupled K_q must be block diagonal");
+        }
+        // K_{i,x}, K_{i,y} are the diagonal of joint i's block.
+        let block = data.joint_stiffness(1).unwrap();
+        assert_eq!(block[(0, 0)], k[(2, 2)]);
+        assert_eq!(block[(1, 1)], k[(3, 3)]);
+    }
+}
+
+#[test]
+fn the_stiffness_slope_predicts_a_change_of_tension_level() {
+    // Decoupled: moving joint i's level moves only its λ; K_q is affine in it.
+    let (_, robot, routing) = setups().remove(0);
+    let model = ArmStiffness::new(&routing).unwrap();
+    let mut data = model.data(&robot, &routing);
+    let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];
+    let f0 = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+    for joint in 0..5 {
+        let mut levels = [0.2; 5];
+        model.joint_level(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        let k_before = data.k_q().to_owned();
+        let lambda_before = data.intervals()[joint].lambda_at_level(0.2);
+        let mut slope = Mat::zeros(10, 10);
+        model.stiffness_slope(&routing, &mut data, joint, slope.as_mut()).unwrap();
+        levels[joint] = 0.9;
+        model.joint_level(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        let delta = data.intervals()[joint].lambda_at_level(0.9) - lambda_before;
+        let predicted = &k_before + &slope * faer::Scale(delta);
+        let err = max_abs((data.k_q().to_owned() - &predicted).as_ref()) / max_abs(data.k_q());
+        assert!(err <= 1e-12, "joint {joint}: slope prediction off by {err:e}");
+        assert!(slope[(2 * joint, 2 * joint)].abs() > 0.0);
+    }
+}
+
+#[test]
+fn routed_tension_sensitivity_keeps_every_joint_balanced() {
+    let (_, robot, routing) = setups().remove(1);
+    let model = ArmStiffness::new(&routing).unwrap();
+    let mut data = model.data(&robot, &routing);
+    let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];
+    model.joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &[0.1; 5]).unwrap();
+    let mut delta = vec![0.0; 15];
+    for joint in 0..5 {
+        model
+            .statics()
+            .tension_sensitivity(&data.cables, &data.statics, joint, &mut delta)
+            .unwrap();
+        let j = data.cables.jacobian().unwrap();
+        for d in 0..10 {
+            let torque: f64 = (0..15).map(|c| j[(c, d)] * delta[c]).sum();
+            assert!(torque.abs() <= 1e-9, "joint {joint}: δf unbalances DOF {d} by {torque:e}");
+        }
+        // Distal joints' tensions do not move.
+        assert!(delta[3 * (joint + 1)..].iter().all(|&x| x == 0.0));
+        if joint > 0 {
+            assert!(
+                delta[..3 * joint].iter().any(|&x| x.abs() > 1e-6),
+                "routed: proximal tensions follow"
+            );
+        }
+    }
+}
