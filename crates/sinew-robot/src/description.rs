@@ -3,7 +3,7 @@
 //! ```toml
 //! urdf = "cdhrm5.urdf"           # path relative to this file
 //! tip_link = "end_effector"      # its origin is the end-effector point
-//! gravity = [0.0, -9.81, 0.0]    # m/s², base frame (the mounting)
+//! gravity = [0.0, 9.81, 0.0]     # m/s², base frame (the mounting)
 //! payload = 0.8                  # kg, optional: the stated load capability (Table I)
 //! ```
 

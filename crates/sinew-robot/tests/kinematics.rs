@@ -8,8 +8,8 @@ use nalgebra::{Matrix4, Vector3};
 use sinew_robot::RobotData;
 
 // The platform's geometry as chosen in robots/cdhrm5/README.md.
-const D1: f64 = 0.015;
-const D2: f64 = 0.015;
+const D1: f64 = 0.0;
+const D2: f64 = 0.03;
 const LINK: f64 = 0.22;
 const JOINTS: usize = 5;
 
@@ -108,20 +108,20 @@ fn mass_is_folded_into_bodies() {
 #[test]
 fn gravity_comes_from_the_description() {
     let robot = common::cdhrm5();
-    assert_eq!(robot.gravity(), Vector3::new(0.0, -9.81, 0.0));
+    assert_eq!(robot.gravity(), Vector3::new(0.0, 9.81, 0.0));
     let mut data = RobotData::new(&robot);
     robot.forward_kinematics(&mut data, &[0.0; 10]).unwrap();
     let mut tg = [0.0; 10];
     robot.gravity_torque(&mut data, &mut tg).unwrap();
-    // Straight horizontal arm: joint 1's x axis carries every link, link i's centre of mass
-    // at height z_i − d1 above the axis. Rot(x, q) moves (0, 0, z) to (0, −z sin q, z cos q),
-    // so V = 9.81 Σ m y has ∂V/∂q = −9.81 Σ m (z_i − d1): T_g[0] is that (negative) value.
+    // Straight horizontal arm, y pointing down: joint 1's x axis carries every link, link i's
+    // centre of mass at z_i − d1 beyond the axis. Rot(x, q) moves (0, 0, z) to
+    // (0, −z sin q, z cos q), so V = −9.81 Σ m y has ∂V/∂q = 9.81 Σ m (z_i − d1) at q = 0.
     let mut moment = 0.0;
     for i in 0..JOINTS {
         let z = D1 + D2 + LINK / 2.0 + i as f64 * (D1 + D2 + LINK);
         moment += 0.24 * 9.81 * (z - D1);
     }
-    assert_relative_eq!(tg[0], -moment, epsilon = 1e-12);
+    assert_relative_eq!(tg[0], moment, epsilon = 1e-12);
     // About y, gravity (along y) has no moment.
     assert_relative_eq!(tg[1], 0.0, epsilon = 1e-12);
 }

@@ -386,8 +386,8 @@ fn evaluation_errors_are_typed() {
 
 #[test]
 fn a_segment_that_collapses_is_an_error_not_a_nan() {
-    // A hole on the base at (0, 0.01, 0.015) and one on the cross of joint 1 (frame at the
-    // joint centre, z = 0.015) at (0, 0, 0.01): they meet at q_11 = −π/2.
+    // A hole on the base at (0, 0.01, d1) and one on the cross of joint 1 (frame at the joint
+    // centre, z = d1 = 0 on cdhrm5) at (0, 0, 0.01): they meet at q_11 = −π/2.
     let robot = common::cdhrm5();
     let text = r#"
 tension_limits = [20.0, 600.0]
@@ -397,7 +397,7 @@ area = 1e-6
 [[cable]]
 name = "folding"
 holes = [
-  { link = "base_link", point = [0.0, 0.01, 0.015] },
+  { link = "base_link", point = [0.0, 0.01, 0.0] },
   { link = "cross1", point = [0.0, 0.0, 0.01] },
   { link = "link1", point = [0.02, 0.0, 0.0] },
 ]
@@ -422,18 +422,29 @@ holes = [
 fn hessian_at_zero_is_minus_d1_d2_over_d1_plus_d2() {
     // At Q = 0 a crossing segment runs along z; bending either axis shortens it by
     // d1·d2/(d1 + d2)·q²/2 whatever the hole's radius and angle (robots/cdhrm5/README.md).
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
-    let mut rdata = RobotData::new(&robot);
-    let mut data = RoutingData::new(&routing);
-    compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &[0.0; 10], Order::Hessians)
+    for (d1, d2) in [(0.015, 0.015), (0.01, 0.025), (0.0, 0.03)] {
+        let chain = UniformChain { d1, d2, ..UniformChain::like_cdhrm5(5) };
+        let robot = chain.build().unwrap();
+        let spec = RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled);
+        let routing = Routing::new(&robot, &spec, "<gen>").unwrap();
+        let mut rdata = RobotData::new(&robot);
+        let mut data = RoutingData::new(&routing);
+        compute_cable_geometry(
+            &routing,
+            &robot,
+            &mut rdata,
+            &mut data,
+            &[0.0; 10],
+            Order::Hessians,
+        )
         .unwrap();
-    let expected = -0.015 * 0.015 / 0.03;
-    let mut h = Mat::<f64>::zeros(10, 10);
-    for (c, cable) in routing.cables().iter().enumerate() {
-        data.cable_hessian(&routing, c, h.as_mut()).unwrap();
-        for k in [2 * cable.joint, 2 * cable.joint + 1] {
-            assert!((h[(k, k)] - expected).abs() < 1e-15, "{}: {}", cable.name, h[(k, k)]);
+        let expected = -d1 * d2 / (d1 + d2);
+        let mut h = Mat::<f64>::zeros(10, 10);
+        for (c, cable) in routing.cables().iter().enumerate() {
+            data.cable_hessian(&routing, c, h.as_mut()).unwrap();
+            for k in [2 * cable.joint, 2 * cable.joint + 1] {
+                assert!((h[(k, k)] - expected).abs() < 1e-15, "{}: {}", cable.name, h[(k, k)]);
+            }
         }
     }
 }
