@@ -13,6 +13,8 @@
 //! - [`statics`]: cable-joint statics, tension intervals and distribution, `T0` and `∂T0/∂Q`
 //!   (`sinew-statics`).
 //! - [`stiffness`]: joint stiffness, `K_q`, end compliance and stiffness (`sinew-stiffness`).
+//! - [`indicators`]: the paper's joint indicators, sweeps and stiffness ellipsoids
+//!   (`sinew-indicators`).
 //!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
@@ -21,3 +23,4 @@ pub use sinew_robot as robot;
 pub use sinew_routing as routing;
 pub use sinew_statics as statics;
 pub use sinew_stiffness as stiffness;
+pub use sinew_indicators as indicators;

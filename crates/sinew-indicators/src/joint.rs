@@ -1,0 +1,219 @@
+//! The joint stiffness indicator (eq. 20): one joint's stiffness over its feasible tension
+//! interval.
+//!
+//! # Math
+//! For universal joint `i` at angles `q = [q_i1, q_i2]` holding the torque `τ` with its three
+//! cables, the feasible tensions are `f(λ) = f_p + λ n`, `λ ∈ [λ_min, λ_max]` (eq. 22–23), and
+//! the joint stiffness `K(λ) = Σ_c f_c(λ) H_c + J_cᵀ K_l J_c` is affine in `λ`. So
+//! `K_{i,x} = K[0,0]` and `K_{i,y} = K[1,1]` (eq. 20) range between their values at the two
+//! ends of the interval, and
+//!
+//! ```text
+//! σ_{i,x} = [K_{i,x}, Δk_{i,x}]ᵀ,  K_{i,x} ∈ [K^min, K^max],  Δk_{i,x} = K^max − K^min   (eq. 20)
+//! ```
+//!
+//! This is the paper's single-joint model: the joint with its own three cables, the other joints
+//! at the angles given (zero by default) and their cables slack. It is meant for the decoupled
+//! routing, where no other cable touches the joint; in the routed model the cables of distal
+//! joints cross it too, and the arm-level analysis (`sinew_stiffness::ArmStiffness`) is the
+//! one that accounts for them.
+
+use faer::Mat;
+use nalgebra::{Matrix2, Matrix3x2, Vector2};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::{TensionInterval, TensionLimits, tension_interval};
+use sinew_stiffness::{joint_block, joint_stiffness};
+
+use crate::error::IndicatorError;
+
+/// The range of one stiffness component over the feasible tensions, and its width (eq. 20).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Indicator {
+    /// `[K^min, K^max]`, N m/rad.
+    pub range: [f64; 2],
+    /// `Δk = K^max − K^min`, N m/rad.
+    pub delta: f64,
+}
+
+impl Indicator {
+    fn from_ends(a: f64, b: f64) -> Indicator {
+        let range = [a.min(b), a.max(b)];
+        Indicator { range, delta: range[1] - range[0] }
+    }
+}
+
+/// One joint's stiffness over its feasible tension interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointStiffnessRange {
+    /// The feasible tension interval.
+    pub interval: TensionInterval,
+    /// Joint stiffness at `λ_min` (least total tension), 2 × 2, N m/rad.
+    pub k_at_min: Matrix2<f64>,
+    /// Joint stiffness at `λ_max` (most total tension), 2 × 2, N m/rad.
+    pub k_at_max: Matrix2<f64>,
+    /// The controllable part at both ends (`Σ f_c H_c`), N m/rad.
+    pub controllable: [Matrix2<f64>; 2],
+    /// The inherent part (`J_cᵀ K_l J_c`, the same at both ends), N m/rad.
+    pub inherent: Matrix2<f64>,
+}
+
+impl JointStiffnessRange {
+    /// `σ_{i,x}`: the range of `K_{i,x}` and its width (eq. 20).
+    pub fn sigma_x(&self) -> Indicator {
+        Indicator::from_ends(self.k_at_min[(0, 0)], self.k_at_max[(0, 0)])
+    }
+
+    /// `σ_{i,y}`: the range of `K_{i,y}` and its width (eq. 20).
+    pub fn sigma_y(&self) -> Indicator {
+        Indicator::from_ends(self.k_at_min[(1, 1)], self.k_at_max[(1, 1)])
+    }
+
+    /// The joint stiffness at tension level `s ∈ [0, 1]` (affine in `λ`).
+    pub fn at_level(&self, s: f64) -> Matrix2<f64> {
+        self.k_at_min + s * (self.k_at_max - self.k_at_min)
+    }
+}
+
+/// A single joint of an arm, probed alone (Pinocchio-style model/data: this is the data, built
+/// once for a robot and routing, reused for every evaluation).
+#[derive(Debug, Clone)]
+pub struct JointProbe {
+    joint: usize,
+    /// Index of the first of the joint's three cables (cables are ordered by joint).
+    first_cable: usize,
+    limits: TensionLimits,
+    q: Vec<f64>,
+    tensions: Vec<f64>,
+    robot_data: RobotData,
+    cables: RoutingData,
+    controllable: Mat<f64>,
+    inherent: Mat<f64>,
+}
+
+impl JointProbe {
+    /// A probe of universal joint `joint` (0-based), the other joints at zero.
+    ///
+    /// # Errors
+    /// [`IndicatorError::NoSuchJoint`]; [`IndicatorError::Statics`] when the joint does not
+    /// have exactly three cables of its own.
+    pub fn new(
+        robot: &Robot,
+        routing: &Routing,
+        joint: usize,
+    ) -> Result<JointProbe, IndicatorError> {
+        let joints = robot.dof() / 2;
+        if joint >= joints {
+            return Err(IndicatorError::NoSuchJoint { joint, joints });
+        }
+        let own: Vec<usize> =
+            (0..routing.cable_count()).filter(|&c| routing.cable_joints()[c] == joint).collect();
+        let first_cable = own.first().copied().unwrap_or(0);
+        if own.len() != 3 || own[2] != first_cable + 2 {
+            return Err(sinew_statics::StaticsError::UnsupportedRouting {
+                reason: format!(
+                    "joint {} has {} cables; the single-joint model needs its own three",
+                    joint + 1,
+                    own.len()
+                ),
+            }
+            .into());
+        }
+        let [f_min, f_max] = routing.tension_limits();
+        let n = robot.dof();
+        Ok(JointProbe {
+            joint,
+            first_cable,
+            limits: TensionLimits { f_min, f_max },
+            q: vec![0.0; n],
+            tensions: vec![0.0; routing.cable_count()],
+            robot_data: RobotData::new(robot),
+            cables: RoutingData::new(routing),
+            controllable: Mat::zeros(n, n),
+            inherent: Mat::zeros(n, n),
+        })
+    }
+
+    /// The probed joint (0-based).
+    pub fn joint(&self) -> usize {
+        self.joint
+    }
+
+    /// Set the angles of the other joints (length dof; the probed joint's entries are
+    /// overwritten by each evaluation).
+    ///
+    /// # Errors
+    /// [`IndicatorError::Robot`] for a wrong length.
+    pub fn set_configuration(&mut self, q: &[f64]) -> Result<(), IndicatorError> {
+        if q.len() != self.q.len() {
+            return Err(sinew_robot::RobotError::DimensionMismatch {
+                what: "joint configuration Q",
+                expected: self.q.len(),
+                got: q.len(),
+            }
+            .into());
+        }
+        self.q.copy_from_slice(q);
+        Ok(())
+    }
+
+    /// The joint's stiffness over its feasible interval at angles `q` holding torque `tau`
+    /// (eq. 20, 22–23). No allocation.
+    ///
+    /// # Errors
+    /// Angles outside the joint limits ([`IndicatorError::Robot`]); an infeasible torque
+    /// ([`IndicatorError::Statics`]); geometry errors.
+    pub fn evaluate(
+        &mut self,
+        robot: &Robot,
+        routing: &Routing,
+        q: [f64; 2],
+        tau: [f64; 2],
+    ) -> Result<JointStiffnessRange, IndicatorError> {
+        let i = self.joint;
+        self.q[2 * i] = q[0];
+        self.q[2 * i + 1] = q[1];
+        robot.check_limits(&self.q)?;
+        compute_cable_geometry(
+            routing,
+            robot,
+            &mut self.robot_data,
+            &mut self.cables,
+            &self.q,
+            Order::Hessians,
+        )?;
+        let j = self.cables.jacobian()?;
+        let first = self.first_cable;
+        let block = Matrix3x2::from_fn(|r, c| j[(first + r, 2 * i + c)]);
+        let interval = tension_interval(i, &block, &Vector2::new(tau[0], tau[1]), self.limits)?;
+        let mut ends = [Matrix2::zeros(); 2];
+        let mut controllable = [Matrix2::zeros(); 2];
+        let mut inherent = Matrix2::zeros();
+        for (end, lambda) in [interval.lambda_min, interval.lambda_max].into_iter().enumerate() {
+            let f = interval.tensions(lambda);
+            self.tensions.fill(0.0);
+            self.tensions[first..first + 3].copy_from_slice(f.as_slice());
+            joint_stiffness(
+                routing,
+                &self.cables,
+                &self.tensions,
+                self.controllable.as_mut(),
+                self.inherent.as_mut(),
+            )?;
+            let kc = joint_block(self.controllable.as_ref(), i)
+                .ok_or(IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
+            let ki = joint_block(self.inherent.as_ref(), i)
+                .ok_or(IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
+            controllable[end] = kc;
+            inherent = ki;
+            ends[end] = kc + ki;
+        }
+        Ok(JointStiffnessRange {
+            interval,
+            k_at_min: ends[0],
+            k_at_max: ends[1],
+            controllable,
+            inherent,
+        })
+    }
+}

@@ -1,0 +1,21 @@
+//! # sinew-indicators
+//!
+//! The paper's stiffness indicators (section III.C):
+//!
+//! - the joint stiffness indicator `σ_{i,x} = [K_{i,x}, Δk_{i,x}]ᵀ`, `σ_{i,y}` (eq. 20) of a
+//!   joint over its feasible tension interval ([`JointProbe`], [`JointStiffnessRange`]);
+//! - sweeps of those over a grid of the joint's angles, in parallel ([`sweep_joint`], the
+//!   paper's Fig. 5);
+//! - the end stiffness ellipsoid of `K_fd` (eq. 21): semi-axes, principal directions, `λ_min`,
+//!   condition number, volume, directional stiffness ([`StiffnessEllipsoid`]).
+#![deny(missing_docs)]
+
+mod ellipsoid;
+mod error;
+mod joint;
+mod sweep;
+
+pub use ellipsoid::StiffnessEllipsoid;
+pub use error::IndicatorError;
+pub use joint::{Indicator, JointProbe, JointStiffnessRange};
+pub use sweep::{AngleGrid, SweepCell, SweepMaps, sweep_joint};

@@ -1,0 +1,144 @@
+//! The joint indicator, the sweep and the ellipsoid on cdhrm5 and on known matrices.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::f64::consts::PI;
+
+use approx::assert_relative_eq;
+use faer::Mat;
+use nalgebra::{Matrix3, Rotation3, Vector3};
+use sinew_indicators::{AngleGrid, IndicatorError, JointProbe, StiffnessEllipsoid, sweep_joint};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_stiffness::{joint_block, joint_stiffness};
+
+const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+
+fn cdhrm5() -> (Robot, Routing) {
+    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+    let routing = sinew_routing::load(ROBOT_DIR, &robot).unwrap();
+    (robot, routing)
+}
+
+#[test]
+fn the_indicator_is_affine_in_the_tension_level() {
+    let (robot, routing) = cdhrm5();
+    let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
+    let q = [PI / 7.0, -PI / 9.0];
+    let range = probe.evaluate(&robot, &routing, q, [-1.0, 0.5]).unwrap();
+    // Direct evaluation at level s, independent of the probe's two ends.
+    let mut full = vec![0.0; 10];
+    full[0] = q[0];
+    full[1] = q[1];
+    let mut rdata = RobotData::new(&robot);
+    let mut g = RoutingData::new(&routing);
+    compute_cable_geometry(&routing, &robot, &mut rdata, &mut g, &full, Order::Hessians).unwrap();
+    for s in [0.0, 0.3, 0.7, 1.0] {
+        let f = range.interval.tensions_at_level(s);
+        let mut tensions = vec![0.0; 15];
+        tensions[..3].copy_from_slice(f.as_slice());
+        let (mut kc, mut ki) = (Mat::zeros(10, 10), Mat::zeros(10, 10));
+        joint_stiffness(&routing, &g, &tensions, kc.as_mut(), ki.as_mut()).unwrap();
+        let direct = joint_block((&kc + &ki).as_ref(), 0).unwrap();
+        assert_relative_eq!(range.at_level(s), direct, max_relative = 1e-12);
+    }
+    let sx = range.sigma_x();
+    assert_relative_eq!(sx.delta, sx.range[1] - sx.range[0]);
+}
+
+#[test]
+fn e2_more_tension_more_stiffness() {
+    // Spec §6, E2: along the feasible segment every tension and the stiffness rise together.
+    let (robot, routing) = cdhrm5();
+    let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
+    let range = probe.evaluate(&robot, &routing, [PI / 7.0, -PI / 9.0], [-1.0, 0.5]).unwrap();
+    assert!(range.interval.null.iter().all(|&n| n > 0.0), "tensions rise together");
+    assert!(range.k_at_max[(0, 0)] > range.k_at_min[(0, 0)], "K_x rises");
+    assert!(range.k_at_max[(1, 1)] > range.k_at_min[(1, 1)], "K_y rises");
+}
+
+#[test]
+fn sweep_cells_equal_single_evaluations_and_mark_infeasible_points() {
+    let (robot, routing) = cdhrm5();
+    let grid = AngleGrid { lower: -PI / 6.0, upper: PI / 6.0, points: 5 };
+    let maps = sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid).unwrap();
+    assert_eq!(maps.cells.len(), 25);
+    let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
+    for a in 0..5 {
+        for b in 0..5 {
+            let q = [grid.angle(a), grid.angle(b)];
+            let single = probe.evaluate(&robot, &routing, q, [0.3, 0.3]).unwrap();
+            let cell = maps.cell(a, b).unwrap();
+            assert_eq!(cell.k_x, single.sigma_x());
+            assert_eq!(cell.k_y, single.sigma_y());
+        }
+    }
+    // A torque no cable set can hold: every cell infeasible, no error.
+    let maps = sweep_joint(&robot, &routing, 0, [50.0, 0.0], grid).unwrap();
+    assert_eq!(maps.feasible(), 0);
+}
+
+#[test]
+fn bad_probes_and_grids_are_errors() {
+    let (robot, routing) = cdhrm5();
+    assert!(matches!(
+        JointProbe::new(&robot, &routing, 5),
+        Err(IndicatorError::NoSuchJoint { joint: 5, joints: 5 })
+    ));
+    let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
+    let err = probe.evaluate(&robot, &routing, [1.0, 0.0], [0.3, 0.3]).unwrap_err();
+    assert!(
+        matches!(err, IndicatorError::Robot(sinew_robot::RobotError::OutOfLimits { .. })),
+        "{err:?}"
+    );
+    let grid = AngleGrid { lower: 0.1, upper: 0.1, points: 3 };
+    assert!(matches!(
+        sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid),
+        Err(IndicatorError::InvalidGrid { .. })
+    ));
+}
+
+#[test]
+fn ellipsoid_of_a_rotated_diagonal_stiffness() {
+    let r = Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+    let k = r.matrix()
+        * Matrix3::from_diagonal(&Vector3::new(400.0, 100.0, 25.0))
+        * r.matrix().transpose();
+    let e = StiffnessEllipsoid::new(&k).unwrap();
+    assert_relative_eq!(e.eigenvalues, Vector3::new(25.0, 100.0, 400.0), max_relative = 1e-12);
+    assert_relative_eq!(
+        e.semi_axes().unwrap(),
+        Vector3::new(0.04, 0.01, 0.0025),
+        max_relative = 1e-12
+    );
+    assert_relative_eq!(e.condition_number().unwrap(), 16.0, max_relative = 1e-12);
+    assert_relative_eq!(
+        e.volume().unwrap(),
+        4.0 / 3.0 * PI * 0.04 * 0.01 * 0.0025,
+        max_relative = 1e-12
+    );
+    // The softest direction is the rotated z axis (up to sign).
+    let softest = e.directions.column(0).into_owned();
+    let expected = r * Vector3::z();
+    assert_relative_eq!(softest.dot(&expected).abs(), 1.0, max_relative = 1e-12);
+    assert_relative_eq!(e.directional_stiffness(&expected).unwrap(), 25.0, max_relative = 1e-12);
+    assert_relative_eq!(
+        e.directional_stiffness(&(3.0 * (r * Vector3::x()))).unwrap(),
+        400.0,
+        max_relative = 1e-12
+    );
+    assert!(matches!(
+        e.directional_stiffness(&Vector3::zeros()),
+        Err(IndicatorError::InvalidDirection { .. })
+    ));
+}
+
+#[test]
+fn an_indefinite_k_fd_has_no_semi_axes() {
+    let e =
+        StiffnessEllipsoid::new(&Matrix3::from_diagonal(&Vector3::new(10.0, -1.0, 5.0))).unwrap();
+    assert!(!e.is_positive_definite());
+    assert_eq!(e.lambda_min(), -1.0);
+    assert!(e.semi_axes().is_none() && e.volume().is_none() && e.condition_number().is_none());
+    let nan = Matrix3::from_element(f64::NAN);
+    assert!(matches!(StiffnessEllipsoid::new(&nan), Err(IndicatorError::NonFinite { .. })));
+}
