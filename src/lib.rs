@@ -16,11 +16,19 @@
 //! - [`indicators`]: the paper's joint indicators, sweeps and stiffness ellipsoids
 //!   (`sinew-indicators`).
 //!
+//! [`paper`] holds the paper's experiments (spec §6) as data, checks and fixed-precision
+//! tables, for `cargo xtask reproduce` and the snapshot tests; [`Error`] gathers every crate's
+//! error.
+//!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
 
+mod error;
+pub mod paper;
+
+pub use error::Error;
+pub use sinew_indicators as indicators;
 pub use sinew_robot as robot;
 pub use sinew_routing as routing;
 pub use sinew_statics as statics;
 pub use sinew_stiffness as stiffness;
-pub use sinew_indicators as indicators;

@@ -6,14 +6,15 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-mod table1;
+mod plots;
+mod reproduce;
 
 type DynResult<T> = Result<T, Box<dyn std::error::Error>>;
 
 const USAGE: &str = "usage: cargo xtask <command>
 
 commands:
-  reproduce                       print and write every table of the paper (robots/cdhrm5)
+  reproduce                       every table and figure of the paper (robots/cdhrm5) into docs/reproduction/
   gen-chain --joints N --out FILE [--name NAME] [--d1 M] [--d2 M] [--link-length M]
             [--link-radius M] [--mass-per-link KG] [--limit RAD]
                                   write the URDF of a uniform chain of universal joints";
@@ -21,7 +22,7 @@ commands:
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
-        Some("reproduce") => reproduce(),
+        Some("reproduce") => reproduce::run(&project_root()),
         Some("gen-chain") => gen_chain(&args[1..]),
         Some("-h" | "--help") | None => {
             println!("{USAGE}");
@@ -41,14 +42,6 @@ fn main() -> ExitCode {
 /// The workspace root (xtask lives one level below it).
 fn project_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
-}
-
-fn reproduce() -> DynResult<()> {
-    let robot_dir = project_root().join("robots/cdhrm5");
-    let table = table1::render(&robot_dir)?;
-    println!("Table I: the platform's parameters (read from {})\n", robot_dir.display());
-    println!("{table}");
-    Ok(())
 }
 
 fn gen_chain(args: &[String]) -> DynResult<()> {

@@ -30,9 +30,9 @@ pub enum IndicatorError {
         /// What is wrong.
         reason: String,
     },
-    /// An infeasible tension interval or another statics error.
+    /// An infeasible tension interval or another statics error (boxed: it is large).
     #[error(transparent)]
-    Statics(#[from] sinew_statics::StaticsError),
+    Statics(Box<sinew_statics::StaticsError>),
     /// A stiffness error (boxed: it is large and rare).
     #[error(transparent)]
     Stiffness(Box<sinew_stiffness::StiffnessError>),
@@ -47,5 +47,11 @@ pub enum IndicatorError {
 impl From<sinew_stiffness::StiffnessError> for IndicatorError {
     fn from(e: sinew_stiffness::StiffnessError) -> Self {
         IndicatorError::Stiffness(Box::new(e))
+    }
+}
+
+impl From<sinew_statics::StaticsError> for IndicatorError {
+    fn from(e: sinew_statics::StaticsError) -> Self {
+        IndicatorError::Statics(Box::new(e))
     }
 }

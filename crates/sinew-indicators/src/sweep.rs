@@ -113,9 +113,11 @@ pub fn sweep_joint(
                     let q = [grid.angle(a), grid.angle(b)];
                     let cell = match probe.evaluate(robot, routing, q, tau) {
                         Ok(range) => Some(SweepCell { k_x: range.sigma_x(), k_y: range.sigma_y() }),
-                        Err(IndicatorError::Statics(sinew_statics::StaticsError::Infeasible {
-                            ..
-                        })) => None,
+                        Err(IndicatorError::Statics(e))
+                            if matches!(*e, sinew_statics::StaticsError::Infeasible { .. }) =>
+                        {
+                            None
+                        }
                         Err(e) => return Err(e),
                     };
                     row.push(cell);

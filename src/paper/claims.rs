@@ -1,0 +1,173 @@
+//! The paper's claims about E1–E3 (spec §6), checked numerically.
+
+use std::fmt::Write as _;
+
+use crate::indicators::SweepMaps;
+
+use super::fixed;
+use super::single_joint::{E2Point, Table2Row};
+
+/// A claim of the paper, whether it holds in our model, and the numbers behind the verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Claim {
+    /// Which experiment and what the paper says.
+    pub claim: String,
+    /// Whether our numbers show it.
+    pub holds: bool,
+    /// The numbers behind the verdict.
+    pub evidence: String,
+}
+
+impl Claim {
+    /// `holds` or `does not hold`.
+    pub fn verdict(&self) -> &'static str {
+        if self.holds { "holds" } else { "does not hold" }
+    }
+}
+
+/// Render claims as a markdown list.
+pub fn render_claims(claims: &[Claim]) -> String {
+    let mut s = String::new();
+    for c in claims {
+        let _ = writeln!(s, "- **{}** — {}. {}", c.verdict(), c.claim, c.evidence);
+    }
+    s
+}
+
+/// Check the claims of E1 (Table II), E2 (Fig. 4) and E3 (Fig. 5).
+pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<Claim> {
+    let mut claims = Vec::new();
+
+    // E1: the range at q = 0 is near zero.
+    if let Some(zero) = table.iter().find(|r| r.q == [0.0, 0.0]) {
+        let d = zero.ours_delta();
+        let others = table
+            .iter()
+            .filter(|r| r.q != [0.0, 0.0])
+            .flat_map(|r| r.ours_delta())
+            .fold(f64::INFINITY, f64::min);
+        claims.push(Claim {
+            claim: "E1: at q = [0, 0] the stiffness range is near zero (paper: Δk_x = 0.06, Δk_y = 0.05 N m/rad)".into(),
+            holds: d[0] < 0.1 * others && d[1] < 0.1 * others,
+            evidence: format!(
+                "ours: Δk_x = {}, Δk_y = {} N m/rad; the smallest range at the other four angles is {} N m/rad",
+                fixed(d[0], 3),
+                fixed(d[1], 3),
+                fixed(others, 3)
+            ),
+        });
+    }
+    // E1: q2 < 0 → K_x wider; q2 > 0 → K_y wider.
+    for (sign, axis_name, wider) in [(-1.0, "K_x", 0usize), (1.0, "K_y", 1usize)] {
+        let rows: Vec<&Table2Row> = table.iter().filter(|r| r.q[1] * sign > 0.0).collect();
+        let holds = !rows.is_empty()
+            && rows.iter().all(|r| r.ours_delta()[wider] > r.ours_delta()[1 - wider]);
+        let mut evidence = String::from("ours (Δk_x, Δk_y):");
+        for r in &rows {
+            let d = r.ours_delta();
+            let _ = write!(
+                evidence,
+                " q = [{}, {}]: ({}, {});",
+                fixed(r.q[0], 3),
+                fixed(r.q[1], 3),
+                fixed(d[0], 2),
+                fixed(d[1], 2)
+            );
+        }
+        claims.push(Claim {
+            claim: format!(
+                "E1/E3: when q2 {} 0, {axis_name} has the wider range (Table II)",
+                if sign < 0.0 { "<" } else { ">" }
+            ),
+            holds,
+            evidence,
+        });
+    }
+
+    // E2: tensions and stiffness rise together, linearly.
+    if let (Some(first), Some(last)) = (e2.first(), e2.last()) {
+        let rising = e2.windows(2).all(|w| {
+            (0..3).all(|k| w[1].tensions[k] > w[0].tensions[k])
+                && w[1].k_x > w[0].k_x
+                && w[1].k_y > w[0].k_y
+        });
+        // Linear: the midpoint is the mean of the ends.
+        let mid = &e2[e2.len() / 2];
+        let linear = (0..3).all(|k| {
+            let expected = first.tensions[k] + mid.level * (last.tensions[k] - first.tensions[k]);
+            (mid.tensions[k] - expected).abs() <= 1e-9 * last.tensions[k].abs().max(1.0)
+        });
+        claims.push(Claim {
+            claim: "E2: as one cable's tension rises, the other two rise linearly, and so does the joint stiffness".into(),
+            holds: rising && linear,
+            evidence: format!(
+                "ours: f from [{}, {}, {}] N to [{}, {}, {}] N; K_x from {} to {}, K_y from {} to {} N m/rad",
+                fixed(first.tensions[0], 1),
+                fixed(first.tensions[1], 1),
+                fixed(first.tensions[2], 1),
+                fixed(last.tensions[0], 1),
+                fixed(last.tensions[1], 1),
+                fixed(last.tensions[2], 1),
+                fixed(first.k_x, 2),
+                fixed(last.k_x, 2),
+                fixed(first.k_y, 2),
+                fixed(last.k_y, 2)
+            ),
+        });
+    }
+
+    // E3: larger |q| mainly raises the maximum, widening the range.
+    let n = e3.grid.points;
+    let centre = e3.cell(n / 2, n / 2).copied();
+    let corners: Vec<_> = [(0, 0), (0, n - 1), (n - 1, 0), (n - 1, n - 1)]
+        .iter()
+        .filter_map(|&(a, b)| e3.cell(a, b).copied())
+        .collect();
+    if let (Some(c), false) = (centre, corners.is_empty()) {
+        let mean = |f: &dyn Fn(&crate::indicators::SweepCell) -> f64| {
+            corners.iter().map(f).sum::<f64>() / corners.len() as f64
+        };
+        let rise_max =
+            mean(&|k| k.k_x.range[1] + k.k_y.range[1]) - (c.k_x.range[1] + c.k_y.range[1]);
+        let rise_min =
+            mean(&|k| k.k_x.range[0] + k.k_y.range[0]) - (c.k_x.range[0] + c.k_y.range[0]);
+        claims.push(Claim {
+            claim: "E3: larger |q1|, |q2| mainly raise the maximum stiffness and so widen the range".into(),
+            holds: rise_max > 0.0 && rise_max > rise_min.abs(),
+            evidence: format!(
+                "ours, corners of the grid against its centre (K_x + K_y): the maximum rises by {} N m/rad, the minimum changes by {} N m/rad",
+                fixed(rise_max, 2),
+                fixed(rise_min, 2)
+            ),
+        });
+    }
+    // E3: sign of q2 decides which axis has the wider range, over the whole map.
+    let mut sums = [[0.0_f64; 2]; 2]; // [q2 < 0, q2 > 0] × [count where Δk_x > Δk_y, count]
+    for a in 0..n {
+        for b in 0..n {
+            let q2 = e3.grid.angle(b);
+            if q2 == 0.0 {
+                continue;
+            }
+            if let Some(c) = e3.cell(a, b) {
+                let side = usize::from(q2 > 0.0);
+                sums[side][1] += 1.0;
+                if c.k_x.delta > c.k_y.delta {
+                    sums[side][0] += 1.0;
+                }
+            }
+        }
+    }
+    let share_x_neg = if sums[0][1] > 0.0 { sums[0][0] / sums[0][1] } else { 0.0 };
+    let share_y_pos = if sums[1][1] > 0.0 { 1.0 - sums[1][0] / sums[1][1] } else { 0.0 };
+    claims.push(Claim {
+        claim: "E3: over the map, q2 < 0 gives K_x the wider range and q2 > 0 gives K_y the wider range".into(),
+        holds: share_x_neg > 0.5 && share_y_pos > 0.5,
+        evidence: format!(
+            "ours: Δk_x > Δk_y at {} % of the feasible points with q2 < 0; Δk_y > Δk_x at {} % of those with q2 > 0",
+            fixed(100.0 * share_x_neg, 1),
+            fixed(100.0 * share_y_pos, 1)
+        ),
+    });
+    claims
+}

@@ -1,0 +1,116 @@
+//! `cargo xtask reproduce`: every table and figure of the paper from `robots/cdhrm5`, written
+//! to `docs/reproduction/`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use sinew::paper;
+
+use crate::{DynResult, plots};
+
+/// Grid of Fig. 5 (points per axis).
+const FIG5_POINTS: usize = 121;
+/// Points along E2's segment.
+const E2_SAMPLES: usize = 41;
+
+/// Which number of a sweep cell a heat map shows.
+type CellValue = fn(&sinew::indicators::SweepCell) -> f64;
+
+struct Output {
+    dir: PathBuf,
+    written: Vec<PathBuf>,
+}
+
+impl Output {
+    fn write(&mut self, name: &str, text: &str) -> DynResult<()> {
+        let path = self.dir.join(name);
+        std::fs::write(&path, text)?;
+        self.written.push(path);
+        Ok(())
+    }
+
+    fn path(&mut self, name: &str) -> PathBuf {
+        let path = self.dir.join(name);
+        self.written.push(path.clone());
+        path
+    }
+}
+
+pub fn run(root: &Path) -> DynResult<()> {
+    let robot_dir = root.join("robots/cdhrm5");
+    let mut out = Output { dir: root.join("docs/reproduction"), written: Vec::new() };
+    std::fs::create_dir_all(&out.dir)?;
+
+    let started = Instant::now();
+    let robot = sinew::robot::load(&robot_dir)?;
+    let routing = sinew::routing::load(&robot_dir, &robot)?;
+    let table_1 = paper::table_1(&robot_dir)?;
+    let table_2 = paper::table_2(&robot, &routing)?;
+    let e2 = paper::e2(&robot, &routing, E2_SAMPLES)?;
+    let e3 = paper::e3(&robot, &routing, FIG5_POINTS)?;
+    let claims = paper::claims_e1_e3(&table_2, &e2, &e3);
+    let computed = started.elapsed();
+
+    out.write("table1.md", &table_1)?;
+    out.write("table2.md", &paper::render_table_2(&table_2))?;
+    out.write("fig4_e2.csv", &paper::e2_csv(&e2))?;
+    out.write("fig5_e3.csv", &paper::e3_csv(&e3))?;
+    plots::fig4(&e2, &out.path("fig4_e2.svg"))?;
+    let maps: [(&str, &str, CellValue); 4] = [
+        ("fig5_kx_min.svg", "(a) minimum of K_x over the feasible tensions", |c| c.k_x.range[0]),
+        ("fig5_kx_max.svg", "(b) maximum of K_x over the feasible tensions", |c| c.k_x.range[1]),
+        ("fig5_ky_min.svg", "(c) minimum of K_y over the feasible tensions", |c| c.k_y.range[0]),
+        ("fig5_ky_max.svg", "(d) maximum of K_y over the feasible tensions", |c| c.k_y.range[1]),
+    ];
+    for (name, title, value) in maps {
+        plots::heat_map(&e3, title, value, &out.path(name))?;
+    }
+
+    let mut report = String::new();
+    writeln!(report, "# Reproduction of the paper on `robots/cdhrm5`\n")?;
+    writeln!(
+        report,
+        "Written by `cargo xtask reproduce`; do not edit by hand. The same tables are"
+    )?;
+    writeln!(
+        report,
+        "snapshot-tested by `cargo test` (`tests/reproduction.rs`). The robot's unstated"
+    )?;
+    writeln!(report, "parameters and why they were chosen: `robots/cdhrm5/README.md`.\n")?;
+    writeln!(report, "## Table I: the platform\n\n{table_1}")?;
+    writeln!(report, "## Table II (E1): joint stiffness at the angle limits\n")?;
+    writeln!(
+        report,
+        "Joint 1, τ = [0.3, 0.3] N m, f ∈ [20, 600] N; ranges over the feasible tensions, N m/rad.\n"
+    )?;
+    writeln!(report, "{}", paper::render_table_2(&table_2))?;
+    writeln!(report, "## Fig. 4 (E2): tensions and stiffness along the feasible segment\n")?;
+    writeln!(report, "q = [π/7, −π/9] rad, τ = [−1, 0.5] N m. Data: `fig4_e2.csv`.\n")?;
+    writeln!(report, "![Fig. 4](fig4_e2.svg)\n")?;
+    writeln!(report, "## Fig. 5 (E3): limits of the joint stiffness over the joint angles\n")?;
+    writeln!(
+        report,
+        "τ = [0.3, 0.3] N m, q1, q2 ∈ [−π/6, π/6] on a {FIG5_POINTS} × {FIG5_POINTS} grid ({} of {} points feasible; grey: infeasible). Data: `fig5_e3.csv`.\n",
+        e3.feasible(),
+        FIG5_POINTS * FIG5_POINTS
+    )?;
+    writeln!(report, "| | minimum | maximum |\n| --- | --- | --- |")?;
+    writeln!(report, "| K_x | ![](fig5_kx_min.svg) | ![](fig5_kx_max.svg) |")?;
+    writeln!(report, "| K_y | ![](fig5_ky_min.svg) | ![](fig5_ky_max.svg) |\n")?;
+    writeln!(report, "## The paper's claims on E1–E3\n\n{}", paper::render_claims(&claims))?;
+    out.write("README.md", &report)?;
+
+    println!(
+        "computed E1–E3 in {:.2} s (Fig. 5 grid {FIG5_POINTS} × {FIG5_POINTS})",
+        computed.as_secs_f64()
+    );
+    for c in &claims {
+        println!("  {}: {}", c.verdict(), c.claim);
+    }
+    println!("wrote:");
+    for path in &out.written {
+        println!("  {}", path.strip_prefix(root).unwrap_or(path).display());
+    }
+    Ok(())
+}
