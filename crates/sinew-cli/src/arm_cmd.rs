@@ -1,0 +1,355 @@
+//! `sinew arm`: the whole arm in a pose under a load (eq. 5–21).
+
+use nalgebra::{Matrix3, Vector6};
+use serde::Serialize;
+use sinew::indicators::StiffnessEllipsoid;
+use sinew::stiffness::{ArmStiffness, RANK_TOLERANCE, StiffnessError, stability_margin};
+
+use crate::cli::ArmArgs;
+use crate::error::{CliError, model_error};
+use crate::input::{check_limits, load, numbers_n, to_radians};
+use crate::output::{
+    Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, na_vec, print_json,
+    q_labels,
+};
+
+/// The JSON document of `sinew arm`.
+#[derive(Debug, Serialize)]
+struct ArmOut {
+    command: &'static str,
+    robot: String,
+    routing_file: String,
+    model: &'static str,
+    gravity: [f64; 3],
+    q: Vec<f64>,
+    wrench: Vec<f64>,
+    levels: Vec<f64>,
+    cables: Vec<String>,
+    t0: Vec<f64>,
+    tensions: Vec<f64>,
+    intervals: Vec<IntervalOut>,
+    k_controllable: Rows,
+    k_inherent: Rows,
+    k_q: Rows,
+    k_w: Rows,
+    j_x: Rows,
+    stable: bool,
+    min_eigenvalue: f64,
+    c_x: Option<Rows>,
+    k_x: Option<Rows>,
+    k_fd: Option<Rows>,
+    k_translational: Option<Rows>,
+    ellipsoid: Option<EllipsoidOut>,
+    notes: Vec<String>,
+}
+
+/// One universal joint's feasible tension interval and stiffness in the arm.
+#[derive(Debug, Serialize)]
+struct IntervalOut {
+    /// 0-based.
+    joint: usize,
+    /// `[λ_min, λ_max]`.
+    lambda: [f64; 2],
+    /// The requested level `s`.
+    level: f64,
+    /// `λ = λ_min + s (λ_max − λ_min)`.
+    lambda_at_level: f64,
+    /// The joint's own cables' tensions at `λ_min` and `λ_max`, N.
+    tensions_at_ends: [Vec<f64>; 2],
+    /// The joint's 2 × 2 block of `K_q`, N m/rad (`K_{i,x}`, `K_{i,y}` on the diagonal).
+    k_joint: Rows,
+}
+
+/// The stiffness ellipsoid of `K_fd`.
+#[derive(Debug, Serialize)]
+struct EllipsoidOut {
+    /// Ascending, N/m.
+    eigenvalues: Vec<f64>,
+    /// `directions[k]`: unit principal direction of `eigenvalues[k]` (base frame).
+    directions: Rows,
+    /// `1/λ_k`, m/N (null unless `K_fd` is positive definite).
+    semi_axes: Option<Vec<f64>>,
+    condition_number: Option<f64>,
+    /// `4π/3 · Π 1/λ_k`, m³/N³.
+    volume: Option<f64>,
+    lambda_min: f64,
+}
+
+/// Run `sinew arm`.
+pub fn run(args: &ArmArgs) -> Result<(), CliError> {
+    let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
+    let (robot, routing) = (&loaded.robot, &loaded.routing);
+    let dof = robot.dof();
+    let joints = dof / 2;
+    let mut q = numbers_n(
+        "--q",
+        &args.q,
+        dof,
+        &format!("angles (2 per universal joint, {joints} joints)"),
+    )?;
+    to_radians(&mut q, args.deg);
+    check_limits(robot, &q)?;
+    let wrench = match &args.wrench {
+        Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
+        None => vec![0.0; 6],
+    };
+    let levels = match &args.levels {
+        Some(text) => numbers_n(
+            "--levels",
+            text,
+            joints,
+            &format!("tension levels (one per universal joint, {joints} joints)"),
+        )?,
+        None => vec![0.0; joints],
+    };
+    if let Some((i, s)) = levels.iter().enumerate().find(|(_, s)| !(0.0..=1.0).contains(*s)) {
+        return Err(CliError::input(format!(
+            "--levels: level {s} of joint {} is outside [0, 1]",
+            i + 1
+        )));
+    }
+    let arm = ArmStiffness::new(routing).map_err(CliError::input)?;
+    let mut data = arm.data(robot, routing);
+    let f0 = Vector6::from_column_slice(&wrench);
+    let mut notes = Vec::new();
+    let outcome = arm.evaluate(robot, routing, &mut data, &q, &f0, &levels);
+    let (stable, full_rank) = match outcome {
+        Ok(()) => (true, true),
+        Err(StiffnessError::Unstable { .. }) => {
+            notes.push(
+                "unstable equilibrium: K_q + K_W is not positive definite (min_eigenvalue < 0), \
+                 so C_x, K_x, K_fd and the ellipsoid do not exist"
+                    .to_owned(),
+            );
+            (false, false)
+        }
+        Err(e @ StiffnessError::RankDeficient { .. }) => {
+            notes.push(format!("{e}: k_x, k_fd and the ellipsoid are null"));
+            (true, false)
+        }
+        Err(e) => return Err(model_error(e)),
+    };
+    let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(model_error)?;
+    let c_x = stable.then(|| faer_rows(data.compliance()));
+    // (C_x[0:3, 0:3])⁻¹ only where that block has full rank (same tolerance as K_x's).
+    let translational_block = Matrix3::from_fn(|i, j| data.compliance()[(i, j)]);
+    let sv = translational_block.singular_values();
+    let block_full_rank = sv.min() > RANK_TOLERANCE * sv.max();
+    let k_translational =
+        if stable && block_full_rank { data.translational_stiffness() } else { None };
+    if stable && k_translational.is_none() {
+        notes.push(
+            "C_x[0:3, 0:3] is singular (the end cannot translate in some direction): \
+             k_translational is null"
+                .to_owned(),
+        );
+    }
+    let (k_x, k_fd, ellipsoid) = if full_rank {
+        let k_fd = data.k_fd();
+        let ellipsoid = StiffnessEllipsoid::new(&k_fd).map_err(model_error)?;
+        let e = EllipsoidOut {
+            eigenvalues: na_vec(&ellipsoid.eigenvalues),
+            directions: na_rows(&ellipsoid.directions.transpose()),
+            semi_axes: ellipsoid.semi_axes().map(|a| na_vec(&a)),
+            condition_number: ellipsoid.condition_number(),
+            volume: ellipsoid.volume(),
+            lambda_min: ellipsoid.lambda_min(),
+        };
+        if !ellipsoid.is_positive_definite() {
+            notes.push("K_fd is not positive definite: the ellipsoid's semi-axes, condition number and volume are null".to_owned());
+        }
+        (Some(faer_rows(data.stiffness())), Some(na_rows(&k_fd)), Some(e))
+    } else {
+        (None, None, None)
+    };
+    let cables: Vec<String> = routing.cables().iter().map(|c| c.name.clone()).collect();
+    let intervals = data
+        .intervals()
+        .iter()
+        .zip(&levels)
+        .map(|(interval, &level)| {
+            let (lo, hi) = interval.ends();
+            IntervalOut {
+                joint: interval.joint,
+                lambda: [interval.lambda_min, interval.lambda_max],
+                level,
+                lambda_at_level: interval.lambda_at_level(level),
+                tensions_at_ends: [na_vec(&lo), na_vec(&hi)],
+                k_joint: data
+                    .joint_stiffness(interval.joint)
+                    .map(|k| na_rows(&k))
+                    .unwrap_or_default(),
+            }
+        })
+        .collect();
+    let g = robot.gravity();
+    let out = ArmOut {
+        command: "arm",
+        robot: robot.name().to_owned(),
+        routing_file: loaded.routing_file.display().to_string(),
+        model: args.common.model.name(),
+        gravity: [g.x, g.y, g.z],
+        q,
+        wrench,
+        levels,
+        cables,
+        t0: data.statics.t0.clone(),
+        tensions: data.tensions().to_vec(),
+        intervals,
+        k_controllable: faer_rows(data.k_controllable()),
+        k_inherent: faer_rows(data.k_inherent()),
+        k_q: faer_rows(data.k_q()),
+        k_w: faer_rows(data.k_w()),
+        j_x: faer_rows(data.j_x()),
+        stable,
+        min_eigenvalue,
+        c_x,
+        k_x,
+        k_fd,
+        k_translational: k_translational.map(|k| na_rows(&k)),
+        ellipsoid,
+        notes,
+    };
+    if args.common.json { print_json(&out) } else { emit(&render(&out, routing)) }
+}
+
+fn render(out: &ArmOut, routing: &sinew::routing::Routing) -> String {
+    let mut s = String::new();
+    let dof = out.q.len();
+    s.push_str(&format!(
+        "arm `{}` ({}: {}), gravity {} m/s²\n",
+        out.robot,
+        out.model,
+        out.routing_file,
+        Fmt::Fixed(3).list(&out.gravity)
+    ));
+    s.push_str(&format!("  Q  = {} rad\n", Fmt::Fixed(5).list(&out.q)));
+    s.push_str(&format!(
+        "  F0 = {} (N, N m; exerted by the end, base frame)\n",
+        Fmt::Fixed(4).list(&out.wrench)
+    ));
+    s.push_str(&format!("  tension levels = {}\n\n", Fmt::Fixed(3).list(&out.levels)));
+
+    s.push_str("Joints (numbered from 1): T0 = T_g + J_xᵀ F0 (N m), feasible λ, tensions (N), K (N m/rad):\n");
+    let mut t = Table::new(&[
+        "joint", "T0 x", "T0 y", "λ_min", "λ_max", "level", "cables", "f1", "f2", "f3", "K_x",
+        "K_y",
+    ])
+    .left(&[6]);
+    for iv in &out.intervals {
+        let i = iv.joint;
+        let own: Vec<usize> = routing
+            .cables()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.joint == i)
+            .map(|(k, _)| k)
+            .collect();
+        let names: Vec<&str> = own.iter().map(|&k| out.cables[k].as_str()).collect();
+        let mut row = vec![
+            format!("{}", i + 1),
+            Fmt::Fixed(4).num(out.t0[2 * i]),
+            Fmt::Fixed(4).num(out.t0[2 * i + 1]),
+            Fmt::Fixed(3).num(iv.lambda[0]),
+            Fmt::Fixed(3).num(iv.lambda[1]),
+            Fmt::Fixed(3).num(iv.level),
+            names.join(","),
+        ];
+        for k in 0..3 {
+            row.push(own.get(k).map(|&c| Fmt::Fixed(3).num(out.tensions[c])).unwrap_or_default());
+        }
+        let diag = |r: usize| iv.k_joint.get(r).and_then(|row| row.get(r)).copied();
+        row.push(diag(0).map(|x| Fmt::Fixed(4).num(x)).unwrap_or_default());
+        row.push(diag(1).map(|x| Fmt::Fixed(4).num(x)).unwrap_or_default());
+        t.row(row);
+    }
+    s.push_str(&t.render(2));
+    let ql = q_labels(dof);
+    let cl = cartesian_labels();
+    s.push('\n');
+    s.push_str(&matrix(
+        "K_q = controllable + inherent (N m/rad):",
+        &out.k_q,
+        Fmt::Fixed(4),
+        &ql,
+        &ql,
+    ));
+    s.push('\n');
+    s.push_str(&matrix("K_W = ∂T0/∂Q (N m/rad):", &out.k_w, Fmt::Fixed(4), &ql, &ql));
+    s.push('\n');
+    s.push_str(&matrix("J_x (linear rows first, base frame):", &out.j_x, Fmt::Fixed(5), &cl, &ql));
+    s.push('\n');
+    if out.stable {
+        s.push_str(&format!(
+            "Stability: STABLE, smallest eigenvalue of K_q + K_W = {} N m/rad\n\n",
+            Fmt::Fixed(6).num(out.min_eigenvalue)
+        ));
+    } else {
+        s.push_str(&format!(
+            "Stability: UNSTABLE, smallest eigenvalue of K_q + K_W = {} N m/rad\n",
+            Fmt::Fixed(6).num(out.min_eigenvalue)
+        ));
+    }
+    if let Some(c_x) = &out.c_x {
+        s.push_str(&matrix(
+            "C_x = J_x (K_q + K_W)⁻¹ J_xᵀ (m/N, rad/(N m)):",
+            c_x,
+            Fmt::Sci(4),
+            &cl,
+            &cl,
+        ));
+        s.push('\n');
+    }
+    if let Some(k_x) = &out.k_x {
+        s.push_str(&matrix("K_x = C_x⁻¹:", k_x, Fmt::Fixed(3), &cl, &cl));
+        s.push('\n');
+    }
+    let xyz = &cl[..3];
+    if let Some(k_fd) = &out.k_fd {
+        s.push_str(&matrix(
+            "K_fd = K_x[0:3, 0:3] (N/m, rotations held; eq. 21):",
+            k_fd,
+            Fmt::Fixed(3),
+            xyz,
+            xyz,
+        ));
+        s.push('\n');
+    }
+    if let Some(k_t) = &out.k_translational {
+        s.push_str(&matrix(
+            "K_t = (C_x[0:3, 0:3])⁻¹ (N/m, rotations free):",
+            k_t,
+            Fmt::Fixed(3),
+            xyz,
+            xyz,
+        ));
+        s.push('\n');
+    }
+    if let Some(e) = &out.ellipsoid {
+        s.push_str("Stiffness ellipsoid of K_fd (eigenvalues ascending):\n");
+        let mut t = Table::new(&["", "λ (N/m)", "1/λ (m/N)", "direction (base frame)"]);
+        for k in 0..e.eigenvalues.len() {
+            t.row(vec![
+                format!("{}", k + 1),
+                Fmt::Fixed(3).num(e.eigenvalues[k]),
+                e.semi_axes
+                    .as_ref()
+                    .map(|a| Fmt::Sci(4).num(a[k]))
+                    .unwrap_or_else(|| "-".to_owned()),
+                e.directions.get(k).map(|d| Fmt::Fixed(4).list(d)).unwrap_or_default(),
+            ]);
+        }
+        s.push_str(&t.render(2));
+        let opt = |x: Option<f64>, f: Fmt| x.map(|v| f.num(v)).unwrap_or_else(|| "-".to_owned());
+        s.push_str(&format!(
+            "  λ_min = {} N/m, condition number = {}, volume = {} m³/N³\n",
+            Fmt::Fixed(3).num(e.lambda_min),
+            opt(e.condition_number, Fmt::Fixed(3)),
+            opt(e.volume, Fmt::Sci(4))
+        ));
+    }
+    for note in &out.notes {
+        s.push_str(&format!("note: {note}\n"));
+    }
+    s
+}

@@ -1,0 +1,164 @@
+//! The command line: subcommands and options (clap derive).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// Stiffness of cable-driven hyper-redundant manipulators, from a robot folder.
+///
+/// SI units throughout (m, rad, N, N m, N/m, N m/rad). Universal joints are numbered from 1
+/// on the command line (`--joint 1` is the joint at the base, as in the paper); the JSON
+/// output counts them from 0 (its `joint` fields). Exit codes: 0 success (an unstable
+/// equilibrium is a result), 1 the model has no answer (e.g. an infeasible load), 2 bad
+/// input (options, counts, limits, robot files). See docs/cli.md.
+#[derive(Debug, Parser)]
+#[command(name = "sinew", version, propagate_version = true)]
+pub struct Cli {
+    /// What to compute.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// The expanded cable routing (every cable's holes, material, limits) and the joints.
+    Routing(RoutingArgs),
+    /// One universal joint alone: its feasible tension interval and stiffness range (eq. 20).
+    ///
+    /// The paper's single-joint model: the joint's own three cables hold the torque, the
+    /// other joints stay at 0 with slack cables. Prints λ_min and λ_max (eq. 22–23), the
+    /// tensions at both ends, the controllable, inherent and total 2 × 2 stiffness at both
+    /// ends, and σ_x, σ_y = [[K_min, K_max], Δk].
+    Joint(JointArgs),
+    /// The whole arm in a pose under a load: T0, tensions, K_q, K_W, C_x, K_x, K_fd, stability.
+    ///
+    /// T0 = T_g + J_xᵀ F0 (eq. 6), every joint's feasible tension interval and the tensions at
+    /// the chosen levels, K_q, K_W = ∂T0/∂Q, J_x, then C_x = J_x (K_q + K_W)⁻¹ J_xᵀ and
+    /// K_x = C_x⁻¹ (eq. 19), K_fd = K_x[0:3, 0:3] (rotations held) and K_t = (C_x[0:3, 0:3])⁻¹
+    /// (rotations free), and the stiffness ellipsoid of K_fd. An unstable equilibrium
+    /// (K_q + K_W not positive definite) is a result, exit 0: C_x, K_x and K_fd are then
+    /// absent (null in JSON). An infeasible load is an error, exit 1.
+    Arm(ArmArgs),
+    /// A joint's stiffness range over a grid of its two angles (Fig. 5 maps).
+    ///
+    /// N × N points over the joint's angle limits (both axes), the other joints at 0: the
+    /// minimum and maximum of K_x and of K_y over the feasible tensions at each point, empty
+    /// (null in JSON) where the torque cannot be held.
+    Sweep(SweepArgs),
+}
+
+/// Which routing file of the robot folder to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Model {
+    /// `DIR/cables.toml`: each cable crosses only the joint it drives (the paper's model).
+    Decoupled,
+    /// `DIR/cables-routed.toml`: each cable also passes through every proximal disc.
+    Routed,
+}
+
+impl Model {
+    /// The routing file's name in a robot folder.
+    pub fn file_name(self) -> &'static str {
+        match self {
+            Model::Decoupled => "cables.toml",
+            Model::Routed => "cables-routed.toml",
+        }
+    }
+
+    /// The option value.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Decoupled => "decoupled",
+            Model::Routed => "routed",
+        }
+    }
+}
+
+/// Options shared by every subcommand.
+#[derive(Debug, Args)]
+pub struct Common {
+    /// Robot folder: robot.toml (URDF path, tip link, gravity), the URDF, cables.toml
+    /// (decoupled routing) and cables-routed.toml (routed routing).
+    #[arg(long, value_name = "DIR")]
+    pub robot: PathBuf,
+    /// Routing model: `decoupled` reads DIR/cables.toml, `routed` reads DIR/cables-routed.toml.
+    #[arg(long, value_enum, default_value_t = Model::Decoupled)]
+    pub model: Model,
+    /// Print one JSON document (schema in docs/cli.md) instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `sinew routing`.
+#[derive(Debug, Args)]
+pub struct RoutingArgs {
+    #[command(flatten)]
+    pub common: Common,
+}
+
+/// `sinew joint`.
+#[derive(Debug, Args)]
+pub struct JointArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Universal joint, numbered from 1 at the base (the paper's numbering; JSON `joint` is
+    /// 0-based). The other joints stay at 0 and their cables slack.
+    #[arg(long, value_name = "I", allow_hyphen_values = true)]
+    pub joint: String,
+    /// The joint's two angles, about x then y: Q1,Q2 (rad; degrees with --deg).
+    #[arg(long, value_name = "Q1,Q2", allow_hyphen_values = true)]
+    pub q: String,
+    /// The torque the joint's three cables hold: T1,T2 (N m).
+    #[arg(long, value_name = "T1,T2", allow_hyphen_values = true)]
+    pub torque: String,
+    /// Read --q in degrees (the output stays in radians).
+    #[arg(long)]
+    pub deg: bool,
+}
+
+/// `sinew arm`.
+#[derive(Debug, Args)]
+pub struct ArmArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// The pose: 2n angles Q1,...,Q2n, base first, x then y for each joint (rad; degrees
+    /// with --deg).
+    #[arg(long, value_name = "Q1,...,Q2n", allow_hyphen_values = true)]
+    pub q: String,
+    /// F0, the wrench the end-effector exerts on its environment, base frame:
+    /// FX,FY,FZ,MX,MY,MZ (N, N m). Default zero.
+    #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
+    pub wrench: Option<String>,
+    /// Tension level of each joint in [0, 1] along its feasible interval (0: least total
+    /// tension, 1: most), S1,...,Sn base first. Default all 0.
+    #[arg(long, value_name = "S1,...,Sn", allow_hyphen_values = true)]
+    pub levels: Option<String>,
+    /// Ignore gravity (zero gravity vector instead of robot.toml's).
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Read --q in degrees (the output stays in radians).
+    #[arg(long)]
+    pub deg: bool,
+}
+
+/// `sinew sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Universal joint, numbered from 1 at the base (JSON `joint` is 0-based). The other
+    /// joints stay at 0.
+    #[arg(long, value_name = "I", allow_hyphen_values = true)]
+    pub joint: String,
+    /// The torque the joint's three cables hold: T1,T2 (N m).
+    #[arg(long, value_name = "T1,T2", allow_hyphen_values = true)]
+    pub torque: String,
+    /// Grid points per axis (≥ 2) over the joint's angle limits.
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub grid: String,
+    /// Write the maps as CSV (q1_rad,q2_rad,k_x_min,k_x_max,k_y_min,k_y_max; empty fields
+    /// where infeasible) to FILE; the tables are then replaced by a summary.
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: Option<PathBuf>,
+}

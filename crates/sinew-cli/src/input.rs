@@ -1,0 +1,128 @@
+//! Reading what the user gives: the robot folder and the comma-separated numbers.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use sinew::robot::{DESCRIPTION_FILE, Robot, RobotDescription, RobotError};
+use sinew::routing::Routing;
+
+use crate::cli::Model;
+use crate::error::CliError;
+
+/// A robot folder, loaded: its description, the robot and the routing of the chosen model.
+#[derive(Debug)]
+pub struct Loaded {
+    /// `robot.toml`, read.
+    pub description: RobotDescription,
+    /// The robot (gravity zeroed when asked).
+    pub robot: Robot,
+    /// The routing of the chosen model.
+    pub routing: Routing,
+    /// The routing file read.
+    pub routing_file: PathBuf,
+}
+
+/// Load a robot folder: `robot.toml`, its URDF, and `cables.toml` or `cables-routed.toml`.
+///
+/// Every missing piece is an input error naming the folder and the file.
+pub fn load(dir: &Path, model: Model, no_gravity: bool) -> Result<Loaded, CliError> {
+    let shown = dir.display();
+    if !dir.exists() {
+        return Err(CliError::input(format!("--robot: robot folder `{shown}` does not exist")));
+    }
+    if !dir.is_dir() {
+        return Err(CliError::input(format!(
+            "--robot: `{shown}` is not a folder (give the robot folder holding {DESCRIPTION_FILE})"
+        )));
+    }
+    if !dir.join(DESCRIPTION_FILE).is_file() {
+        return Err(CliError::input(format!(
+            "--robot: robot folder `{shown}` has no {DESCRIPTION_FILE}"
+        )));
+    }
+    let description = RobotDescription::read(dir).map_err(CliError::input)?;
+    if !description.urdf.is_file() {
+        return Err(CliError::input(format!(
+            "--robot: robot folder `{shown}` has no URDF: {} names `{}`, which does not exist",
+            description.path.display(),
+            description.urdf.display()
+        )));
+    }
+    let robot = description.load_robot().map_err(|e| match e {
+        // The only link robot.toml names is the tip: say where it comes from.
+        RobotError::NoSuchLink { .. } => {
+            CliError::input(format!("{}: tip_link: {e}", description.path.display()))
+        }
+        e => CliError::input(e),
+    })?;
+    let routing_file = dir.join(model.file_name());
+    if !routing_file.is_file() {
+        return Err(CliError::input(format!(
+            "--model {}: robot folder `{shown}` has no {}",
+            model.name(),
+            model.file_name()
+        )));
+    }
+    let routing = sinew::routing::load(&routing_file, &robot).map_err(CliError::input)?;
+    let robot = if no_gravity { robot.with_gravity(Vector3::zeros()) } else { robot };
+    Ok(Loaded { description, robot, routing, routing_file })
+}
+
+/// Comma-separated finite numbers, e.g. `0.1,-0.2, 3e-1`.
+pub fn numbers(option: &str, text: &str) -> Result<Vec<f64>, CliError> {
+    if text.trim().is_empty() {
+        return Err(CliError::input(format!("{option}: no numbers given")));
+    }
+    text.split(',')
+        .map(|item| {
+            let item = item.trim();
+            match item.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                Ok(_) => Err(CliError::input(format!("{option}: `{item}` is not a finite number"))),
+                Err(_) => Err(CliError::input(format!("{option}: `{item}` is not a number"))),
+            }
+        })
+        .collect()
+}
+
+/// Exactly `count` comma-separated numbers; `what` says what they are (for the message).
+pub fn numbers_n(option: &str, text: &str, count: usize, what: &str) -> Result<Vec<f64>, CliError> {
+    let values = numbers(option, text)?;
+    if values.len() != count {
+        return Err(CliError::input(format!(
+            "{option}: expected {count} {what}, got {}",
+            values.len()
+        )));
+    }
+    Ok(values)
+}
+
+/// A 1-based universal joint number of the command line, checked against the robot, as the
+/// 0-based index.
+pub fn joint(text: &str, robot: &Robot) -> Result<usize, CliError> {
+    let joints = robot.dof() / 2;
+    let number: i64 = text.trim().parse().map_err(|_| {
+        CliError::input(format!("--joint: `{}` is not a joint number (1 to {joints})", text.trim()))
+    })?;
+    if number < 1 || number > joints as i64 {
+        return Err(CliError::input(format!(
+            "--joint {number}: no such joint; the robot `{}` has {joints} universal joints, numbered 1 to {joints} from the base",
+            robot.name()
+        )));
+    }
+    Ok((number - 1) as usize)
+}
+
+/// Angles to radians.
+pub fn to_radians(values: &mut [f64], deg: bool) {
+    if deg {
+        for v in values {
+            *v = v.to_radians();
+        }
+    }
+}
+
+/// Check a full configuration against the joint limits (an input error naming the joint).
+pub fn check_limits(robot: &Robot, q: &[f64]) -> Result<(), CliError> {
+    robot.check_limits(q).map_err(|e| CliError::input(format!("--q: {e}")))
+}

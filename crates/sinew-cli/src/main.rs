@@ -1,0 +1,47 @@
+//! `sinew`: the stiffness of cable-driven hyper-redundant manipulators from the command line,
+//! as aligned tables or one JSON document (`--json`, schema in docs/cli.md).
+//!
+//! - `sinew routing`: the expanded routing and the joints;
+//! - `sinew joint`: one joint's feasible tension interval and stiffness range;
+//! - `sinew arm`: T0, tensions, K_q, K_W, C_x, K_x, K_fd, the ellipsoid and stability;
+//! - `sinew sweep`: a joint's min/max stiffness maps over its angles (Fig. 5).
+//!
+//! Errors print one line, `sinew: <message>`, on standard error and exit with 2 (bad input)
+//! or 1 (the model has no answer, e.g. an infeasible load); never a panic.
+
+mod arm_cmd;
+mod cli;
+mod error;
+mod input;
+mod joint_cmd;
+mod output;
+mod routing_cmd;
+mod sweep_cmd;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use crate::cli::{Cli, Command};
+use crate::error::CliError;
+
+fn run(cli: &Cli) -> Result<(), CliError> {
+    match &cli.command {
+        Command::Routing(args) => routing_cmd::run(args),
+        Command::Joint(args) => joint_cmd::run(args),
+        Command::Arm(args) => arm_cmd::run(args),
+        Command::Sweep(args) => sweep_cmd::run(args),
+    }
+}
+
+fn main() -> ExitCode {
+    // clap prints its own usage errors (exit 2) and --help / --version (exit 0).
+    let cli = Cli::parse();
+    match run(&cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sinew: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

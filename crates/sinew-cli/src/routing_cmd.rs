@@ -1,0 +1,184 @@
+//! `sinew routing`: the expanded cable routing and the robot's joints.
+
+use serde::Serialize;
+use sinew::routing::RoutingModel;
+
+use crate::cli::RoutingArgs;
+use crate::error::CliError;
+use crate::input::{Loaded, load};
+use crate::output::{Fmt, Table, emit, print_json};
+
+/// The JSON document of `sinew routing`.
+#[derive(Debug, Serialize)]
+struct RoutingOut<'a> {
+    command: &'static str,
+    robot: &'a str,
+    robot_dir: String,
+    urdf: String,
+    tip_link: &'a str,
+    gravity: [f64; 3],
+    routing_file: String,
+    model: RoutingModel,
+    youngs_modulus: f64,
+    area: f64,
+    tension_limits: [f64; 2],
+    joints: Vec<JointOut<'a>>,
+    cables: Vec<CableOut<'a>>,
+}
+
+/// A revolute joint.
+#[derive(Debug, Serialize)]
+struct JointOut<'a> {
+    /// Index in Q, 0-based.
+    index: usize,
+    name: &'a str,
+    /// The universal joint it belongs to, 0-based.
+    universal_joint: usize,
+    /// Unit axis in the joint frame.
+    axis: [f64; 3],
+    lower: f64,
+    upper: f64,
+}
+
+/// A cable.
+#[derive(Debug, Serialize)]
+struct CableOut<'a> {
+    name: &'a str,
+    joint: usize,
+    holes: Vec<HoleOut<'a>>,
+    free_length: f64,
+    routed_length: f64,
+    elastic_length: f64,
+    stiffness: f64,
+    f_min: f64,
+    f_max: f64,
+}
+
+/// A hole: a point in a link's frame.
+#[derive(Debug, Serialize)]
+struct HoleOut<'a> {
+    link: &'a str,
+    point: [f64; 3],
+}
+
+/// Run `sinew routing`.
+pub fn run(args: &RoutingArgs) -> Result<(), CliError> {
+    let loaded = load(&args.common.robot, args.common.model, false)?;
+    let out = document(&loaded);
+    if args.common.json { print_json(&out) } else { emit(&render(&out)) }
+}
+
+fn document(loaded: &Loaded) -> RoutingOut<'_> {
+    let Loaded { description, robot, routing, routing_file } = loaded;
+    let g = robot.gravity();
+    let [f_min, f_max] = routing.tension_limits();
+    RoutingOut {
+        command: "routing",
+        robot: robot.name(),
+        robot_dir: description.dir.display().to_string(),
+        urdf: description.urdf.display().to_string(),
+        tip_link: &description.settings.tip_link,
+        gravity: [g.x, g.y, g.z],
+        routing_file: routing_file.display().to_string(),
+        model: routing.model(),
+        youngs_modulus: routing.youngs_modulus(),
+        area: routing.area(),
+        tension_limits: routing.tension_limits(),
+        joints: robot
+            .joints()
+            .iter()
+            .enumerate()
+            .map(|(index, j)| JointOut {
+                index,
+                name: &j.name,
+                universal_joint: index / 2,
+                axis: [j.axis.x, j.axis.y, j.axis.z],
+                lower: j.lower,
+                upper: j.upper,
+            })
+            .collect(),
+        cables: routing
+            .cables()
+            .iter()
+            .map(|c| CableOut {
+                name: &c.name,
+                joint: c.joint,
+                holes: c
+                    .holes
+                    .iter()
+                    .map(|h| HoleOut { link: &h.link, point: [h.point.x, h.point.y, h.point.z] })
+                    .collect(),
+                free_length: c.free_length,
+                routed_length: c.routed_length,
+                elastic_length: c.elastic_length,
+                stiffness: c.stiffness,
+                f_min,
+                f_max,
+            })
+            .collect(),
+    }
+}
+
+fn render(out: &RoutingOut<'_>) -> String {
+    let mut s = String::new();
+    let model = match out.model {
+        RoutingModel::Decoupled => "decoupled",
+        RoutingModel::Routed => "routed",
+        RoutingModel::Explicit => "explicit (hole by hole)",
+    };
+    s.push_str(&format!(
+        "robot `{}`: {}\n  tip link `{}`, gravity {} m/s² (base frame)\n",
+        out.robot,
+        out.urdf,
+        out.tip_link,
+        Fmt::Fixed(3).list(&out.gravity)
+    ));
+    s.push_str(&format!(
+        "routing: {} ({model}), {} cables\n  E = {} Pa, A = {} m², tensions in [{}, {}] N\n\n",
+        out.routing_file,
+        out.cables.len(),
+        Fmt::Sci(4).num(out.youngs_modulus),
+        Fmt::Sci(4).num(out.area),
+        out.tension_limits[0],
+        out.tension_limits[1]
+    ));
+    s.push_str("Revolute joints, base first (universal joints numbered from 1), limits in rad:\n");
+    let mut joints = Table::new(&["q", "name", "joint", "axis", "lower", "upper"]).left(&[1]);
+    for j in &out.joints {
+        joints.row(vec![
+            format!("q{}{}", j.universal_joint + 1, j.index % 2 + 1),
+            j.name.to_owned(),
+            format!("{}", j.universal_joint + 1),
+            Fmt::Fixed(3).list(&j.axis),
+            Fmt::Fixed(5).num(j.lower),
+            Fmt::Fixed(5).num(j.upper),
+        ]);
+    }
+    s.push_str(&joints.render(2));
+    s.push_str(
+        "\nCables (joint numbered from 1; holes base first, points in m in the hole's link frame):\n",
+    );
+    let mut cables =
+        Table::new(&["cable", "joint", "k = EA/l (N/m)", "l (m)", "hole", "link", "x", "y", "z"])
+            .left(&[5]);
+    for c in &out.cables {
+        for (k, h) in c.holes.iter().enumerate() {
+            let mut cells = if k == 0 {
+                vec![
+                    c.name.to_owned(),
+                    format!("{}", c.joint + 1),
+                    Fmt::Fixed(2).num(c.stiffness),
+                    Fmt::Fixed(4).num(c.elastic_length),
+                ]
+            } else {
+                vec![String::new(); 4]
+            };
+            cells.push(format!("{}", k + 1));
+            cells.push(h.link.to_owned());
+            cells.extend(h.point.iter().map(|&x| Fmt::Fixed(6).num(x)));
+            cables.row(cells);
+        }
+    }
+    s.push_str(&cables.render(2));
+    s
+}
