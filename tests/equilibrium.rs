@@ -229,10 +229,13 @@ fn compliance_matches_the_nonlinear_equilibrium_at_random_stable_configurations(
                 0.0,
             );
             let levels: Vec<f64> = (0..5).map(|_| rng.random_range(0.0..1.0)).collect();
-            // Stable with a margin of 0.5 N m/rad: 0.01 N at the ~1.2 m tip is 0.012 N m, which
+            // Stable with a margin of 0.6 N m/rad: 0.01 N at the ~1.2 m tip is 0.012 N m, which
             // turns such a joint by ~0.02 rad. Closer to the stability limit 0.01 N is no longer
-            // a small load (Newton then finds the arm snapping to another equilibrium).
-            if let Some(e) = check(&robot, &routing, &q, &load, &levels, 0.5, 1.0) {
+            // a small load (Newton then finds the arm snapping to another equilibrium). With the
+            // calibrated geometry (joint centre on the distal disc) one of these draws, at a
+            // margin of 0.53 N m/rad, is off by 3.6 % at 0.01 N but by 0.03 % at 0.001 N: second
+            // order in the probe, i.e. C_x exact and 0.01 N no longer small there.
+            if let Some(e) = check(&robot, &routing, &q, &load, &levels, 0.6, 1.0) {
                 worst = worst.max(e.symmetric);
                 worst_one_sided = worst_one_sided.max(e.one_sided);
                 checked += 1;

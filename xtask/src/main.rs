@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod calibrate;
 mod plots;
 mod reproduce;
 
@@ -17,13 +18,15 @@ commands:
   reproduce                       every table and figure of the paper (robots/cdhrm5) into docs/reproduction/
   gen-chain --joints N --out FILE [--name NAME] [--d1 M] [--d2 M] [--link-length M]
             [--link-radius M] [--mass-per-link KG] [--limit RAD]
-                                  write the URDF of a uniform chain of universal joints";
+                                  write the URDF of a uniform chain of universal joints
+  calibrate [--check]             fit the unstated joint geometry to Table II and write it into robots/cdhrm5";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("reproduce") => reproduce::run(&project_root()),
         Some("gen-chain") => gen_chain(&args[1..]),
+        Some("calibrate") => calibrate::run(&args[1..]),
         Some("-h" | "--help") | None => {
             println!("{USAGE}");
             Ok(())

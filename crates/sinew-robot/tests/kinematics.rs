@@ -7,9 +7,10 @@ use approx::assert_relative_eq;
 use nalgebra::{Matrix4, Vector3};
 use sinew_robot::RobotData;
 
-// The platform's geometry as chosen in robots/cdhrm5/README.md.
-const D1: f64 = 0.0;
-const D2: f64 = 0.03;
+// The platform's geometry as chosen in robots/cdhrm5/README.md (d1, d2 fitted to Table II by
+// `cargo xtask calibrate`: the joint centre on the distal disc).
+const D1: f64 = 0.03;
+const D2: f64 = 0.0;
 const LINK: f64 = 0.22;
 const JOINTS: usize = 5;
 
@@ -96,7 +97,7 @@ fn link_points_resolve_through_fixed_joints() {
 fn mass_is_folded_into_bodies() {
     let robot = common::cdhrm5();
     assert_relative_eq!(robot.moving_mass(), 1.2, epsilon = 1e-12);
-    // Body of joint1_y carries link1: 0.24 kg, centre of mass d2 + 0.11 m above the pivot.
+    // Body of joint1_y carries link1: 0.24 kg, centre of mass d2 + 0.11 m beyond the pivot.
     let body = &robot.bodies()[2];
     assert_eq!(body.name, "pivot1");
     assert_relative_eq!(body.mass, 0.24, epsilon = 1e-12);

@@ -177,14 +177,17 @@ pub struct RoutingSpec {
     pub cables: Vec<ExplicitCable>,
 }
 
-/// Hole radius of the cdhrm5 pattern, m (see robots/cdhrm5/README.md).
-pub const CDHRM5_HOLE_RADIUS: f64 = 0.022;
-/// Angle of cable 1 of joint 0 of the cdhrm5 pattern, rad (+y).
-pub const CDHRM5_THETA0: f64 = std::f64::consts::FRAC_PI_2;
+// The cdhrm5 values below are those `cargo xtask calibrate` fitted to Table II and wrote into
+// robots/cdhrm5 (its README says why); tests/structure.rs checks that the files and this
+// pattern agree, so a recalibration that forgets one of them fails `cargo test`.
+/// Hole radius of the cdhrm5 pattern, m (fitted to Table II).
+pub const CDHRM5_HOLE_RADIUS: f64 = 0.02061;
+/// Angle of cable 1 of joint 0 of the cdhrm5 pattern, rad (fitted to Table II, near +x).
+pub const CDHRM5_THETA0: f64 = 0.01379;
 /// Angular offset per joint of the cdhrm5 pattern, rad: 2π/15, 15 evenly spaced holes.
 pub const CDHRM5_JOINT_OFFSET: f64 = TAU / 15.0;
-/// Free length of the cdhrm5 cables from the actuator to the base disc, m.
-pub const CDHRM5_FREE_LENGTH: f64 = 3.6;
+/// Free length of the cdhrm5 cables from the actuator to the base disc, m (fitted to Table II).
+pub const CDHRM5_FREE_LENGTH: f64 = 3.2128;
 /// Young's modulus of the cdhrm5 cables, Pa (Table I).
 pub const CDHRM5_YOUNGS_MODULUS: f64 = 12.5e9;
 /// Cable diameter of cdhrm5, m.

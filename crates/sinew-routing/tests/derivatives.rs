@@ -87,7 +87,8 @@ fn every_cdhrm5_joint_length_is_eq_2() {
         for (c, cable) in routing.cables().iter().enumerate() {
             let i = cable.joint;
             assert_eq!(cable.holes.len(), 2);
-            let T = eq1(0.0, 0.03, q[2 * i], q[2 * i + 1]);
+            // d1 = 30 mm, d2 = 0: the calibrated platform (robots/cdhrm5/README.md).
+            let T = eq1(0.03, 0.0, q[2 * i], q[2 * i + 1]);
             let expected = eq2(cable.holes[0].point, cable.holes[1].point, &T);
             let got = data.lengths().unwrap()[c];
             assert!((got - expected).abs() <= 1e-14, "{}: {got} vs eq. (2) {expected}", cable.name);

@@ -10,12 +10,18 @@ use common::{random_q, rng};
 use faer::Mat;
 use sinew_robot::{RobotData, UniformChain};
 use sinew_routing::{
-    Order, PatternModel, Routing, RoutingData, RoutingError, RoutingModel, RoutingSpec,
+    Order, PatternModel, PerJoint, Routing, RoutingData, RoutingError, RoutingModel, RoutingSpec,
     compute_cable_geometry, compute_cable_geometry_from_kinematics,
 };
 
 /// The least moment arm counted as "non-zero": a hole radius of 22 mm gives arms of that order.
 const NONZERO: f64 = 1e-4;
+
+// The cdhrm5 values that `cargo xtask calibrate` fitted to Table II (robots/cdhrm5/README.md),
+// as the library's generated pattern carries them.
+/// d1, d2 of cdhrm5, m: the joint centre on the distal disc.
+const CDHRM5_D: (f64, f64) = (0.03, 0.0);
+use sinew_routing::spec::{CDHRM5_FREE_LENGTH, CDHRM5_HOLE_RADIUS as CDHRM5_RADIUS, CDHRM5_THETA0};
 
 #[test]
 fn cables_are_ordered_by_joint_three_each() {
@@ -136,9 +142,11 @@ fn cable_stiffness_is_ea_over_elastic_length() {
         for (c, cable) in routing.cables().iter().enumerate() {
             let routed = data.lengths().unwrap()[c];
             assert!((cable.routed_length - routed).abs() < 1e-12, "{name}: {}", cable.name);
-            // Both models give every cable the same elastic length: 3.6 m + 0.25 m per link
-            // before its joint + its 30 mm crossing.
-            let expected_l = 3.6 + 0.25 * cable.joint as f64 + 0.03;
+            // Both models give every cable the same elastic length: the free length (cdhrm5's
+            // calibrated one, 3.6 m for the generated chain) + 0.25 m per link before its joint
+            // + its 30 mm crossing.
+            let free = CDHRM5_FREE_LENGTH;
+            let expected_l = free + 0.25 * cable.joint as f64 + 0.03;
             assert!(
                 (cable.elastic_length - expected_l).abs() < 1e-12,
                 "{name}: {} has l = {}, expected {expected_l}",
@@ -175,11 +183,22 @@ fn cdhrm5_inherent_stiffness_at_zero_is_table_ii_order() {
 #[test]
 fn cdhrm5_files_match_the_generated_pattern() {
     let robot = common::cdhrm5();
-    let chain = UniformChain::like_cdhrm5(5);
+    let (d1, d2) = CDHRM5_D;
+    let chain = UniformChain { d1, d2, ..UniformChain::like_cdhrm5(5) };
     for model in [PatternModel::Decoupled, PatternModel::Routed] {
         let from_file = common::cdhrm5_routing(&robot, model);
-        let generated =
-            Routing::new(&robot, &RoutingSpec::for_uniform_chain(&chain, model), "<gen>").unwrap();
+        let mut spec = RoutingSpec::for_uniform_chain(&chain, model);
+        let pitch = d1 + d2 + chain.link_length;
+        spec.free_length = Some(match model {
+            PatternModel::Decoupled => {
+                PerJoint::Each((0..5).map(|i| CDHRM5_FREE_LENGTH + i as f64 * pitch).collect())
+            }
+            PatternModel::Routed => PerJoint::Uniform(CDHRM5_FREE_LENGTH),
+        });
+        let pattern = spec.pattern.as_mut().unwrap();
+        pattern.radius = Some(PerJoint::Uniform(CDHRM5_RADIUS));
+        pattern.theta0 = CDHRM5_THETA0;
+        let generated = Routing::new(&robot, &spec, "<gen>").unwrap();
         assert_eq!(from_file.cables(), generated.cables(), "{model:?}");
         assert_eq!(from_file.segments(), generated.segments(), "{model:?}");
     }
@@ -193,7 +212,7 @@ fn cdhrm5_holes_are_distinct_and_inside_the_link() {
     for cable in routing.cables() {
         for hole in &cable.holes {
             let r = (hole.point.x.powi(2) + hole.point.y.powi(2)).sqrt();
-            assert!((r - 0.022).abs() < 1e-15 && r < 0.03, "{}: radius {r}", cable.name);
+            assert!((r - CDHRM5_RADIUS).abs() < 1e-15 && r < 0.03, "{}: radius {r}", cable.name);
             assert_eq!(hole.point.z, 0.0);
         }
         let p = cable.holes[cable.holes.len() - 1].point;
@@ -387,7 +406,7 @@ fn evaluation_errors_are_typed() {
 #[test]
 fn a_segment_that_collapses_is_an_error_not_a_nan() {
     // A hole on the base at (0, 0.01, d1) and one on the cross of joint 1 (frame at the joint
-    // centre, z = d1 = 0 on cdhrm5) at (0, 0, 0.01): they meet at q_11 = −π/2.
+    // centre, z = d1 = 0.03 m on cdhrm5) at (0, 0, 0.01): they meet at q_11 = −π/2.
     let robot = common::cdhrm5();
     let text = r#"
 tension_limits = [20.0, 600.0]
@@ -397,7 +416,7 @@ area = 1e-6
 [[cable]]
 name = "folding"
 holes = [
-  { link = "base_link", point = [0.0, 0.01, 0.0] },
+  { link = "base_link", point = [0.0, 0.01, 0.03] },
   { link = "cross1", point = [0.0, 0.0, 0.01] },
   { link = "link1", point = [0.02, 0.0, 0.0] },
 ]

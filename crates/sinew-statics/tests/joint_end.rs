@@ -121,11 +121,11 @@ fn t0_is_gravity_plus_the_load() {
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let t0 = t0_at(robot, &mut rdata, &mut data, &q, &f0);
     // Straight arm along z, tip at 1.25 m: 5 N along y at the tip needs, at joint 1's x axis
-    // (at z = d1 = 0), the torque (p − p_j) × F · x = −1.25 · 5 N m.
+    // (at z = d1 = 0.03 m), the torque (p − p_j) × F · x = −(1.25 − 0.03) · 5 N m.
     let zero_g = robot.with_gravity(Vector3::zeros());
     let mut rdata0 = RobotData::new(&zero_g);
     let load = t0_at(&zero_g, &mut rdata0, &mut data, &q, &f0);
-    approx::assert_relative_eq!(load[0], -1.25 * 5.0, epsilon = 1e-12);
+    approx::assert_relative_eq!(load[0], -(1.25 - 0.03) * 5.0, epsilon = 1e-12);
     approx::assert_relative_eq!(load[1], 0.0, epsilon = 1e-12);
     let gravity = t0_at(robot, &mut rdata, &mut data, &q, &Vector6::zeros());
     for j in 0..10 {
