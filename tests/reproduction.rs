@@ -78,3 +78,24 @@ fn snapshots_are_identical_across_runs() {
     let b = paper::e3_csv(&paper::e3(&robot, &routing, 31).unwrap());
     assert_eq!(a, b, "the parallel sweep must be deterministic");
 }
+
+#[test]
+fn fig_6_e4_decoupled_and_routed() {
+    let (robot, routing) = cdhrm5();
+    let routed =
+        sinew::routing::load(root().join("robots/cdhrm5/cables-routed.toml"), &robot).unwrap();
+    let decoupled = paper::e4(&robot, &routing, "decoupled").unwrap();
+    let routed = paper::e4(&robot, &routed, "routed").unwrap();
+    let rendered_d = paper::render_e4(&decoupled);
+    let rendered_r = paper::render_e4(&routed);
+    insta::assert_snapshot!("e4_decoupled", rendered_d);
+    insta::assert_snapshot!("e4_routed", rendered_r);
+    insta::assert_snapshot!(
+        "e4_routed_vs_decoupled",
+        paper::render_routed_vs_decoupled(&decoupled, &routed)
+    );
+    let claims: Vec<_> = [&decoupled, &routed].into_iter().flat_map(paper::claims_e4).collect();
+    insta::assert_snapshot!("e4_claims", paper::render_claims(&claims));
+    assert_committed("e4_decoupled.md", &rendered_d);
+    assert_committed("e4_routed.md", &rendered_r);
+}

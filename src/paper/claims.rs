@@ -14,14 +14,35 @@ pub struct Claim {
     pub claim: String,
     /// Whether our numbers show it.
     pub holds: bool,
+    /// Whether the numbers needed exist (e.g. not when an equilibrium is unstable).
+    pub checkable: bool,
     /// The numbers behind the verdict.
     pub evidence: String,
 }
 
 impl Claim {
-    /// `holds` or `does not hold`.
+    /// A claim checked against numbers.
+    pub fn checked(claim: impl Into<String>, holds: bool, evidence: impl Into<String>) -> Claim {
+        Claim { claim: claim.into(), holds, checkable: true, evidence: evidence.into() }
+    }
+
+    /// A claim that cannot be checked, and why.
+    pub fn unchecked(claim: impl Into<String>, why: &str) -> Claim {
+        Claim {
+            claim: claim.into(),
+            holds: false,
+            checkable: false,
+            evidence: format!("cannot be checked: {why}"),
+        }
+    }
+
+    /// `holds`, `does not hold`, or `cannot be checked`.
     pub fn verdict(&self) -> &'static str {
-        if self.holds { "holds" } else { "does not hold" }
+        match (self.checkable, self.holds) {
+            (false, _) => "cannot be checked",
+            (true, true) => "holds",
+            (true, false) => "does not hold",
+        }
     }
 }
 
@@ -46,16 +67,16 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
             .filter(|r| r.q != [0.0, 0.0])
             .flat_map(|r| r.ours_delta())
             .fold(f64::INFINITY, f64::min);
-        claims.push(Claim {
-            claim: "E1: at q = [0, 0] the stiffness range is near zero (paper: Δk_x = 0.06, Δk_y = 0.05 N m/rad)".into(),
-            holds: d[0] < 0.1 * others && d[1] < 0.1 * others,
-            evidence: format!(
+        claims.push(Claim::checked(
+            "E1: at q = [0, 0] the stiffness range is near zero (paper: Δk_x = 0.06, Δk_y = 0.05 N m/rad)",
+            d[0] < 0.1 * others && d[1] < 0.1 * others,
+            format!(
                 "ours: Δk_x = {}, Δk_y = {} N m/rad; the smallest range at the other four angles is {} N m/rad",
                 fixed(d[0], 3),
                 fixed(d[1], 3),
                 fixed(others, 3)
             ),
-        });
+        ));
     }
     // E1: q2 < 0 → K_x wider; q2 > 0 → K_y wider.
     for (sign, axis_name, wider) in [(-1.0, "K_x", 0usize), (1.0, "K_y", 1usize)] {
@@ -74,14 +95,14 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
                 fixed(d[1], 2)
             );
         }
-        claims.push(Claim {
-            claim: format!(
+        claims.push(Claim::checked(
+            format!(
                 "E1/E3: when q2 {} 0, {axis_name} has the wider range (Table II)",
                 if sign < 0.0 { "<" } else { ">" }
             ),
             holds,
             evidence,
-        });
+        ));
     }
 
     // E2: tensions and stiffness rise together, linearly.
@@ -97,10 +118,10 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
             let expected = first.tensions[k] + mid.level * (last.tensions[k] - first.tensions[k]);
             (mid.tensions[k] - expected).abs() <= 1e-9 * last.tensions[k].abs().max(1.0)
         });
-        claims.push(Claim {
-            claim: "E2: as one cable's tension rises, the other two rise linearly, and so does the joint stiffness".into(),
-            holds: rising && linear,
-            evidence: format!(
+        claims.push(Claim::checked(
+            "E2: as one cable's tension rises, the other two rise linearly, and so does the joint stiffness",
+            rising && linear,
+            format!(
                 "ours: f from [{}, {}, {}] N to [{}, {}, {}] N; K_x from {} to {}, K_y from {} to {} N m/rad",
                 fixed(first.tensions[0], 1),
                 fixed(first.tensions[1], 1),
@@ -113,7 +134,7 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
                 fixed(first.k_y, 2),
                 fixed(last.k_y, 2)
             ),
-        });
+        ));
     }
 
     // E3: larger |q| mainly raises the maximum, widening the range.
@@ -131,15 +152,15 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
             mean(&|k| k.k_x.range[1] + k.k_y.range[1]) - (c.k_x.range[1] + c.k_y.range[1]);
         let rise_min =
             mean(&|k| k.k_x.range[0] + k.k_y.range[0]) - (c.k_x.range[0] + c.k_y.range[0]);
-        claims.push(Claim {
-            claim: "E3: larger |q1|, |q2| mainly raise the maximum stiffness and so widen the range".into(),
-            holds: rise_max > 0.0 && rise_max > rise_min.abs(),
-            evidence: format!(
+        claims.push(Claim::checked(
+            "E3: larger |q1|, |q2| mainly raise the maximum stiffness and so widen the range",
+            rise_max > 0.0 && rise_max > rise_min.abs(),
+            format!(
                 "ours, corners of the grid against its centre (K_x + K_y): the maximum rises by {} N m/rad, the minimum changes by {} N m/rad",
                 fixed(rise_max, 2),
                 fixed(rise_min, 2)
             ),
-        });
+        ));
     }
     // E3: sign of q2 decides which axis has the wider range, over the whole map.
     let mut sums = [[0.0_f64; 2]; 2]; // [q2 < 0, q2 > 0] × [count where Δk_x > Δk_y, count]
@@ -160,14 +181,14 @@ pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<
     }
     let share_x_neg = if sums[0][1] > 0.0 { sums[0][0] / sums[0][1] } else { 0.0 };
     let share_y_pos = if sums[1][1] > 0.0 { 1.0 - sums[1][0] / sums[1][1] } else { 0.0 };
-    claims.push(Claim {
-        claim: "E3: over the map, q2 < 0 gives K_x the wider range and q2 > 0 gives K_y the wider range".into(),
-        holds: share_x_neg > 0.5 && share_y_pos > 0.5,
-        evidence: format!(
+    claims.push(Claim::checked(
+            "E3: over the map, q2 < 0 gives K_x the wider range and q2 > 0 gives K_y the wider range",
+            share_x_neg > 0.5 && share_y_pos > 0.5,
+            format!(
             "ours: Δk_x > Δk_y at {} % of the feasible points with q2 < 0; Δk_y > Δk_x at {} % of those with q2 > 0",
             fixed(100.0 * share_x_neg, 1),
             fixed(100.0 * share_y_pos, 1)
         ),
-    });
+    ));
     claims
 }

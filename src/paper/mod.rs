@@ -4,10 +4,14 @@
 //! Every number is printed at a fixed precision with `-0` normalised to `0` ([`fixed`]), so a
 //! rendered table changes only when a number really changes.
 
+mod arm;
 mod claims;
 mod single_joint;
 mod table1;
 
+pub use arm::{
+    E4, E4_CASES, E4Case, E4Joint, claims_e4, e4, render_e4, render_routed_vs_decoupled,
+};
 pub use claims::{Claim, claims_e1_e3, render_claims};
 pub use single_joint::{
     E2_Q, E2_TORQUE, E2Point, E3_TORQUE, PAPER_TABLE_2, TABLE_2_TORQUE, Table2Row, e2, e2_csv, e3,

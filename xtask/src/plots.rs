@@ -137,3 +137,83 @@ pub fn heat_map(
     root.present()?;
     Ok(())
 }
+
+/// Fig. 6 (E4): the deformation ellipsoids `{K_fd⁻¹ F : |F| = 1 N}` of the cases (a)–(d),
+/// projected on the base frame's xy, xz and yz planes; one row per routing model.
+pub fn fig6(models: &[&sinew::paper::E4], path: &Path) -> DynResult<()> {
+    use nalgebra::{Matrix2, Matrix3};
+    let rows = models.len().max(1);
+    let root = SVGBackend::new(path, (1200, 400 * rows as u32)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly((rows, 3));
+    let planes = [("x", "y", 0usize, 1usize), ("x", "z", 0, 2), ("y", "z", 1, 2)];
+    let colours = [BLACK, RED, BLUE, GREEN];
+    for (r, e4) in models.iter().enumerate() {
+        // Each case's projected outline on each plane.
+        let mut outlines: Vec<Vec<Vec<(f64, f64)>>> = vec![Vec::new(); 3];
+        let mut extent: f64 = 1e-9;
+        for case in &e4.cases {
+            let Some((k_fd, _)) = &case.k_fd else {
+                for o in outlines.iter_mut() {
+                    o.push(Vec::new());
+                }
+                continue;
+            };
+            let a: Matrix3<f64> = k_fd.try_inverse().unwrap_or_else(Matrix3::zeros);
+            let a2 = a * a.transpose();
+            for (p, &(_, _, i, j)) in planes.iter().enumerate() {
+                let m = Matrix2::new(a2[(i, i)], a2[(i, j)], a2[(j, i)], a2[(j, j)]);
+                let l = m.cholesky().map(|c| c.l()).unwrap_or_else(Matrix2::zeros);
+                let pts: Vec<(f64, f64)> = (0..=120)
+                    .map(|k| {
+                        let t = std::f64::consts::TAU * k as f64 / 120.0;
+                        let v = l * nalgebra::Vector2::new(t.cos(), t.sin());
+                        extent = extent.max(v[0].abs()).max(v[1].abs());
+                        (v[0], v[1])
+                    })
+                    .collect();
+                outlines[p].push(pts);
+            }
+        }
+        let extent = extent * 1.1;
+        for (p, &(h, v, _, _)) in planes.iter().enumerate() {
+            let area = &areas[r * 3 + p];
+            let mut chart = ChartBuilder::on(area)
+                .caption(format!("{}: {h}{v} projection", e4.model), ("sans-serif", 16))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(55)
+                .build_cartesian_2d(-extent..extent, -extent..extent)?;
+            chart
+                .configure_mesh()
+                .x_desc(format!("d{h} per unit force (m/N)"))
+                .y_desc(format!("d{v} (m/N)"))
+                .x_labels(6)
+                .y_labels(6)
+                .x_label_formatter(&|x| fixed(*x, 3))
+                .y_label_formatter(&|y| fixed(*y, 3))
+                .draw()?;
+            for (c, pts) in outlines[p].iter().enumerate() {
+                if pts.is_empty() {
+                    continue;
+                }
+                let colour = colours[c % colours.len()];
+                let label = e4.cases[c].name.split(' ').next().unwrap_or("").to_owned();
+                chart
+                    .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))?
+                    .label(label)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .border_style(BLACK)
+                .background_style(WHITE)
+                .draw()?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}

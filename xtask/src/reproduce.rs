@@ -50,6 +50,10 @@ pub fn run(root: &Path) -> DynResult<()> {
     let e2 = paper::e2(&robot, &routing, E2_SAMPLES)?;
     let e3 = paper::e3(&robot, &routing, FIG5_POINTS)?;
     let claims = paper::claims_e1_e3(&table_2, &e2, &e3);
+    let routed = sinew::routing::load(robot_dir.join("cables-routed.toml"), &robot)?;
+    let e4 = [paper::e4(&robot, &routing, "decoupled")?, paper::e4(&robot, &routed, "routed")?];
+    let claims_e4: Vec<_> = e4.iter().flat_map(paper::claims_e4).collect();
+    let comparison = paper::render_routed_vs_decoupled(&e4[0], &e4[1]);
     let computed = started.elapsed();
 
     out.write("table1.md", &table_1)?;
@@ -99,13 +103,37 @@ pub fn run(root: &Path) -> DynResult<()> {
     writeln!(report, "| K_x | ![](fig5_kx_min.svg) | ![](fig5_kx_max.svg) |")?;
     writeln!(report, "| K_y | ![](fig5_ky_min.svg) | ![](fig5_ky_max.svg) |\n")?;
     writeln!(report, "## The paper's claims on E1–E3\n\n{}", paper::render_claims(&claims))?;
+    writeln!(
+        report,
+        "## Fig. 6 (E4): end stiffness under different joint stiffness distributions\n"
+    )?;
+    writeln!(
+        report,
+        "Q = [−π/7, −π/9, −π/9, −π/11, π/6, π/7, π/8, −π/15, −π/12, −π/10] rad, F0 = [0, 5, 0, 0, 0, 0] (N, N m; the wrench the tip exerts, base frame), gravity on (mounting: `robots/cdhrm5/README.md`). Tension levels: 0 = least total tension on the joint's feasible interval, 1 = most. Stability margin: smallest eigenvalue of K_q + K_W.\n"
+    )?;
+    for (k, model) in e4.iter().enumerate() {
+        let rendered = paper::render_e4(model);
+        out.write(&format!("e4_{}.md", model.model), &rendered)?;
+        writeln!(
+            report,
+            "### {}\n\n{rendered}",
+            if k == 0 { "Decoupled (the paper's model)" } else { "Routed" }
+        )?;
+    }
+    plots::fig6(&[&e4[0], &e4[1]], &out.path("fig6_e4.svg"))?;
+    writeln!(
+        report,
+        "Deformation ellipsoids `{{K_fd⁻¹ F : |F| = 1 N}}` of the cases that are feasible and stable:\n\n![Fig. 6](fig6_e4.svg)\n"
+    )?;
+    writeln!(report, "## Routed beside decoupled (beyond the paper)\n\n{comparison}")?;
+    writeln!(report, "## The paper's conclusions on E4\n\n{}", paper::render_claims(&claims_e4))?;
     out.write("README.md", &report)?;
 
     println!(
-        "computed E1–E3 in {:.2} s (Fig. 5 grid {FIG5_POINTS} × {FIG5_POINTS})",
+        "computed E1–E4 in {:.2} s (Fig. 5 grid {FIG5_POINTS} × {FIG5_POINTS})",
         computed.as_secs_f64()
     );
-    for c in &claims {
+    for c in claims.iter().chain(&claims_e4) {
         println!("  {}: {}", c.verdict(), c.claim);
     }
     println!("wrote:");
