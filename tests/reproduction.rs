@@ -84,8 +84,12 @@ fn fig_6_e4_decoupled_and_routed() {
     let (robot, routing) = cdhrm5();
     let routed =
         sinew::routing::load(root().join("robots/cdhrm5/cables-routed.toml"), &robot).unwrap();
-    let decoupled = paper::e4(&robot, &routing, "decoupled").unwrap();
-    let routed = paper::e4(&robot, &routed, "routed").unwrap();
+    let decoupled = paper::e4(&robot, &routing, "decoupled", 0.0).unwrap();
+    let routed = paper::e4(&robot, &routed, "routed", 0.0).unwrap();
+    let baseline = paper::e4(&robot, &routing, "decoupled", 0.25).unwrap();
+    let rendered_b = paper::render_e4(&baseline);
+    insta::assert_snapshot!("e4_decoupled_baseline", rendered_b);
+    assert_committed("e4_decoupled_baseline.md", &rendered_b);
     let rendered_d = paper::render_e4(&decoupled);
     let rendered_r = paper::render_e4(&routed);
     insta::assert_snapshot!("e4_decoupled", rendered_d);
@@ -94,7 +98,11 @@ fn fig_6_e4_decoupled_and_routed() {
         "e4_routed_vs_decoupled",
         paper::render_routed_vs_decoupled(&decoupled, &routed)
     );
-    let claims: Vec<_> = [&decoupled, &routed].into_iter().flat_map(paper::claims_e4).collect();
+    let claims: Vec<_> = [&decoupled, &routed]
+        .into_iter()
+        .flat_map(paper::claims_e4_joints)
+        .chain([&decoupled, &routed, &baseline].into_iter().flat_map(paper::claims_e4_end))
+        .collect();
     insta::assert_snapshot!("e4_claims", paper::render_claims(&claims));
     assert_committed("e4_decoupled.md", &rendered_d);
     assert_committed("e4_routed.md", &rendered_r);

@@ -46,6 +46,8 @@ pub struct E4Case {
 pub struct E4 {
     /// `decoupled` or `routed`.
     pub model: String,
+    /// Tension level of the joints a case does not raise (0 in the paper).
+    pub baseline: f64,
     /// `T0 = T_g + J_xᵀ F0`, N m.
     pub t0: Vec<f64>,
     /// Every joint, base first. Empty when the lowest levels are infeasible.
@@ -54,20 +56,27 @@ pub struct E4 {
     pub cases: Vec<E4Case>,
 }
 
-/// The four cases of Fig. 6: (a) every joint lowest, (b) joint 3 raised, (c) joint 5 raised,
-/// (d) joints 3 and 5 raised (joints numbered from 1 at the base).
-pub const E4_CASES: [(&str, [f64; 5]); 4] = [
-    ("(a) every joint at its lowest level", [0.0; 5]),
-    ("(b) joint 3 at its highest level", [0.0, 0.0, 1.0, 0.0, 0.0]),
-    ("(c) joint 5 at its highest level", [0.0, 0.0, 0.0, 0.0, 1.0]),
-    ("(d) joints 3 and 5 at their highest levels", [0.0, 0.0, 1.0, 0.0, 1.0]),
+/// The four cases of Fig. 6: (a) every joint at the baseline level (the lowest in the paper),
+/// (b) joint 3 raised to its highest, (c) joint 5 raised, (d) joints 3 and 5 raised (joints
+/// numbered from 1 at the base). `true` marks a raised joint.
+pub const E4_CASES: [(&str, [bool; 5]); 4] = [
+    ("(a) every joint at the baseline level", [false; 5]),
+    ("(b) joint 3 at its highest level", [false, false, true, false, false]),
+    ("(c) joint 5 at its highest level", [false, false, false, false, true]),
+    ("(d) joints 3 and 5 at their highest levels", [false, false, true, false, true]),
 ];
 
-/// Run E4 on a five-joint robot with a routing.
+/// Run E4 on a five-joint robot with a routing; the joints a case does not raise sit at
+/// tension level `baseline` (0 in the paper).
 ///
 /// # Errors
 /// Only for a routing the statics cannot handle; infeasible or unstable cases are recorded.
-pub fn e4(robot: &Robot, routing: &Routing, model: &str) -> Result<E4, crate::Error> {
+pub fn e4(
+    robot: &Robot,
+    routing: &Routing,
+    model: &str,
+    baseline: f64,
+) -> Result<E4, crate::Error> {
     let arm = ArmStiffness::new(routing)?;
     let mut data = arm.data(robot, routing);
     let f0 = Vector6::from_row_slice(&E4_F0);
@@ -96,7 +105,8 @@ pub fn e4(robot: &Robot, routing: &Routing, model: &str) -> Result<E4, crate::Er
         }
     }
     let mut cases = Vec::new();
-    for (name, levels) in E4_CASES {
+    for (name, raised) in E4_CASES {
+        let levels = raised.map(|r| if r { 1.0 } else { baseline });
         let mut case = E4Case { name, levels, margin: None, k_fd: None, failure: None };
         match arm.joint_level(robot, routing, &mut data, &E4_Q, &f0, &levels) {
             Err(e) => case.failure = Some(format!("infeasible: {e}")),
@@ -119,7 +129,7 @@ pub fn e4(robot: &Robot, routing: &Routing, model: &str) -> Result<E4, crate::Er
         }
         cases.push(case);
     }
-    Ok(E4 { model: model.to_owned(), t0, joints, cases })
+    Ok(E4 { model: model.to_owned(), baseline, t0, joints, cases })
 }
 
 fn vector(v: &[f64], decimals: usize) -> String {
@@ -130,7 +140,12 @@ fn vector(v: &[f64], decimals: usize) -> String {
 /// E4 as markdown: T0, the joints table, the cases table.
 pub fn render_e4(e4: &E4) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "Routing model: **{}**.\n", e4.model);
+    let _ = writeln!(
+        s,
+        "Routing model: **{}**; joints not raised at tension level {}.\n",
+        e4.model,
+        fixed(e4.baseline, 2)
+    );
     let _ = writeln!(s, "T0 = {} N m\n", vector(&e4.t0, 3));
     if e4.joints.is_empty() {
         let _ = writeln!(s, "The lowest tension levels are infeasible: no joint table.\n");
@@ -215,8 +230,21 @@ fn directional_gain(a: &StiffnessEllipsoid, b: &StiffnessEllipsoid) -> Option<Ve
     Some(gain)
 }
 
-/// The paper's conclusions (1)–(3) on E4 (and, for (1), on the joints' ranges).
+/// The run's label in evidence: model and baseline level.
+fn label(e4: &E4) -> String {
+    format!("{}, baseline level {}", e4.model, fixed(e4.baseline, 2))
+}
+
+/// The paper's conclusions (1) and (2) on E4's joints, and (3) on its end stiffness.
 pub fn claims_e4(e4: &E4) -> Vec<Claim> {
+    let mut claims = claims_e4_joints(e4);
+    claims.extend(claims_e4_end(e4));
+    claims
+}
+
+/// Conclusions (1) and (2) on E4's joint table (each joint from its lowest to its highest
+/// level, the others at their lowest).
+pub fn claims_e4_joints(e4: &E4) -> Vec<Claim> {
     let mut claims = Vec::new();
     let unavailable = |claim: &str, why: &str| Claim::unchecked(claim, why);
 
@@ -267,8 +295,14 @@ pub fn claims_e4(e4: &E4) -> Vec<Claim> {
             ),
         ));
     }
-    // (3) end stiffness: joint 3 changes it most but not in every direction; joint 5 mainly in
-    // one direction; 3 and 5 together complement each other.
+    claims
+}
+
+/// Conclusion (3) on E4's cases (a)–(d): joint 3 changes the end stiffness most but not in every
+/// direction; joint 5 mainly in one direction; 3 and 5 together complement each other.
+pub fn claims_e4_end(e4: &E4) -> Vec<Claim> {
+    let mut claims = Vec::new();
+    let unavailable = |claim: &str, why: &str| Claim::unchecked(claim, why);
     let c3 = "Conclusion (3): raising joint 3 changes K_fd most, but not in every direction; joint 5 helps mainly in one direction; joints 3 and 5 together complement each other";
     match (ellipsoid(e4, 0), ellipsoid(e4, 1), ellipsoid(e4, 2), ellipsoid(e4, 3)) {
         (Some(a), Some(b), Some(c), Some(d)) => {
@@ -289,7 +323,7 @@ pub fn claims_e4(e4: &E4) -> Vec<Claim> {
                 most && uneven_b && one_direction_c && complement,
                 format!(
                     "ours ({}): |K_fd(b) − K_fd(a)| = {} vs |K_fd(c) − K_fd(a)| = {} N/m ({}); relative gain along (a)'s principal directions: (b) {} ({}), (c) {} ({}); λ_min: (a) {}, (b) {}, (c) {}, (d) {} N/m ({})",
-                    e4.model,
+                    label(e4),
                     fixed(change(b), 3),
                     fixed(change(c), 3),
                     if most { "joint 3 most" } else { "joint 3 not most" },

@@ -10,7 +10,8 @@ mod single_joint;
 mod table1;
 
 pub use arm::{
-    E4, E4_CASES, E4Case, E4Joint, claims_e4, e4, render_e4, render_routed_vs_decoupled,
+    E4, E4_CASES, E4Case, E4Joint, claims_e4, claims_e4_end, claims_e4_joints, e4, render_e4,
+    render_routed_vs_decoupled,
 };
 pub use claims::{Claim, claims_e1_e3, render_claims};
 pub use single_joint::{

@@ -179,7 +179,10 @@ pub fn fig6(models: &[&sinew::paper::E4], path: &Path) -> DynResult<()> {
         for (p, &(h, v, _, _)) in planes.iter().enumerate() {
             let area = &areas[r * 3 + p];
             let mut chart = ChartBuilder::on(area)
-                .caption(format!("{}: {h}{v} projection", e4.model), ("sans-serif", 16))
+                .caption(
+                    format!("{}, baseline {}: {h}{v} projection", e4.model, fixed(e4.baseline, 2)),
+                    ("sans-serif", 16),
+                )
                 .margin(10)
                 .x_label_area_size(40)
                 .y_label_area_size(55)
