@@ -11,8 +11,6 @@
 //! the one-sided error shrinks in proportion to `δw`, i.e. that `C_x` is the exact derivative.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::f64::consts::PI;
-
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use nalgebra::{Vector3, Vector6};
@@ -24,18 +22,7 @@ use sinew::stiffness::{ArmStiffness, stability_margin};
 
 const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
 
-const E4_Q: [f64; 10] = [
-    -PI / 7.0,
-    -PI / 9.0,
-    -PI / 9.0,
-    -PI / 11.0,
-    PI / 6.0,
-    PI / 7.0,
-    PI / 8.0,
-    -PI / 15.0,
-    -PI / 12.0,
-    -PI / 10.0,
-];
+use sinew::paper::E4_Q;
 
 /// Everything the nonlinear model needs, frozen at the reference equilibrium.
 struct Elastic<'a> {
