@@ -96,7 +96,7 @@ pub fn run(root: &Path) -> DynResult<()> {
     writeln!(report, "## Table II (E1): joint stiffness at the angle limits\n")?;
     writeln!(
         report,
-        "Joint 1, τ = [0.3, 0.3] N m, f ∈ [20, 600] N; ranges over the feasible tensions, N m/rad.\n"
+        "Joint 1, τ = [0.3, 0.3] N m, f ∈ [20, 600] N; ranges over the feasible tensions, N m/rad. The unstated single-joint geometry (hole radius, θ0, d1, d2, cable stiffness) is fitted to this table by `cargo xtask calibrate` (spec §7; values and bounds in `robots/cdhrm5/README.md`).\n"
     )?;
     writeln!(report, "{}", paper::render_table_2(&table_2))?;
     writeln!(report, "## Fig. 4 (E2): tensions and stiffness along the feasible segment\n")?;
