@@ -298,6 +298,95 @@ impl Robot {
         }
         Ok(())
     }
+
+    /// The partial velocities of a body point, `v_j = a_j × (p − p_j)` for the joints `j < b`
+    /// that move it (`b` its body), zero for the others, into `out` (length dof, base frame):
+    /// the linear rows of [`Robot::point_jacobian`] as 3-vectors (same arithmetic, same
+    /// values); its angular rows are the axes `a_j` ([`RobotData::joint_axis`]).
+    ///
+    /// Needs [`Robot::forward_kinematics`] first. `O(dof)`, no allocation.
+    ///
+    /// # Errors
+    /// [`RobotError::WorkspaceMismatch`], [`RobotError::NoSuchBody`],
+    /// [`RobotError::DimensionMismatch`].
+    pub fn point_partial_velocities(
+        &self,
+        data: &RobotData,
+        point: &BodyPoint,
+        out: &mut [Vector3<f64>],
+    ) -> Result<()> {
+        data.check(self)?;
+        self.check_body(point.body)?;
+        if out.len() != self.dof() {
+            return Err(RobotError::DimensionMismatch {
+                what: "point partial velocities",
+                expected: self.dof(),
+                got: out.len(),
+            });
+        }
+        let p = world_point(data, point);
+        let b = point.body.min(self.dof());
+        for j in 0..b {
+            out[j] = data.o_axis[j].cross(&(p - data.o_pivot[j]));
+        }
+        out[b..].fill(Vector3::zeros());
+        Ok(())
+    }
+
+    /// The generators of `∂(J(Q)ᵀ F)/∂Q` for a wrench `F = [f; m]` fixed in the base frame:
+    /// `upper` and `lower` (length dof each, base frame, N m).
+    ///
+    /// # Math
+    /// With `v_k = a_k × (p − p_k)` for the joints `k < b` that move the point (`b` its body):
+    ///
+    /// ```text
+    /// upper_k = v_k × f,   lower_k = v_k × f + a_k × m        (k < b; both 0 for k ≥ b)
+    /// ∂(JᵀF)_j/∂q_i = a_i · lower_j   (i ≤ j),      a_j · upper_i   (i > j)
+    /// ```
+    ///
+    /// the entries of [`Robot::wrench_torque_derivative`] (dof × dof): each triangle is
+    /// semiseparable, a dot product of the proximal joint's axis and a generator of the distal
+    /// joint. `upper = lower` exactly when `m = 0` (then the matrix is symmetric).
+    ///
+    /// Needs [`Robot::forward_kinematics`] first. `O(dof)`, no allocation.
+    ///
+    /// # Errors
+    /// [`RobotError::WorkspaceMismatch`], [`RobotError::NoSuchBody`],
+    /// [`RobotError::DimensionMismatch`].
+    pub fn wrench_torque_derivative_generators(
+        &self,
+        data: &RobotData,
+        point: &BodyPoint,
+        wrench: &Vector6<f64>,
+        upper: &mut [Vector3<f64>],
+        lower: &mut [Vector3<f64>],
+    ) -> Result<()> {
+        data.check(self)?;
+        self.check_body(point.body)?;
+        let n = self.dof();
+        for (what, got) in [
+            ("wrench torque derivative generators (upper)", upper.len()),
+            ("wrench torque derivative generators (lower)", lower.len()),
+        ] {
+            if got != n {
+                return Err(RobotError::DimensionMismatch { what, expected: n, got });
+            }
+        }
+        let f = wrench.fixed_rows::<3>(0).into_owned();
+        let m = wrench.fixed_rows::<3>(3).into_owned();
+        let moment = m != Vector3::zeros();
+        let p = world_point(data, point);
+        let b = point.body.min(n);
+        for k in 0..b {
+            let a = data.o_axis[k];
+            let u = a.cross(&(p - data.o_pivot[k])).cross(&f);
+            upper[k] = u;
+            lower[k] = if moment { u + a.cross(&m) } else { u };
+        }
+        upper[b..].fill(Vector3::zeros());
+        lower[b..].fill(Vector3::zeros());
+        Ok(())
+    }
 }
 
 #[inline]

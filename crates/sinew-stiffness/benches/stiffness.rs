@@ -1,7 +1,8 @@
 //! `cargo bench -p sinew-stiffness`: one joint's stiffness, and the whole pipeline `Q → K_x`
 //! (kinematics, cable geometry with Hessians, T0, tensions, K_q, K_W, J_x, factorisations) for
-//! cdhrm5 at E4 and generated chains of 25, 50 and 100 universal joints (50, 100, 200 DOF).
-//! docs/performance.md has the table.
+//! cdhrm5 at E4 and generated chains of 25, 50 and 100 universal joints (50, 100, 200 DOF),
+//! and the 200-DOF decoupled chain once more with gravity and a tip wrench (non-zero,
+//! non-symmetric `K_W`). docs/performance.md has the table.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::hint::black_box;
@@ -13,7 +14,7 @@ use sinew_robot::{Robot, RobotData, UniformChain};
 use sinew_routing::{
     Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
 };
-use sinew_stiffness::{ArmStiffness, joint_stiffness};
+use sinew_stiffness::{ArmStiffness, EndSolver, joint_stiffness};
 
 fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
     let chain = UniformChain::like_cdhrm5(joints);
@@ -97,6 +98,24 @@ fn bench_pipeline(c: &mut Criterion) {
                 })
             });
         }
+    }
+    // The 200-DOF decoupled chain with a non-zero, non-symmetric K_W: slight gravity and a tip
+    // force with a moment (the general structured sweep, after its verdict sweep).
+    {
+        let (robot, routing) = chain(100, PatternModel::Decoupled);
+        let robot = robot.with_gravity(Vector3::new(0.0, 5e-4, 0.0));
+        let model = ArmStiffness::new(&routing).unwrap();
+        let mut data = model.data(&robot, &routing);
+        let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
+        let levels = vec![0.1; 100];
+        let f0 = Vector6::new(0.0, 0.005, 0.0, 0.0, 0.0, 0.0005);
+        model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        assert_eq!(data.end_solver(), EndSolver::Structured);
+        group.bench_with_input(BenchmarkId::new("uniform decoupled loaded", 200), &q, |b, q| {
+            b.iter(|| {
+                model.evaluate(&robot, &routing, &mut data, black_box(q), &f0, &levels).unwrap()
+            })
+        });
     }
     group.finish();
 }

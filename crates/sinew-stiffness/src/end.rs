@@ -12,6 +12,13 @@
 //! in the base frame). Stability is decided by a Cholesky factorisation of the symmetric part
 //! (faer, in place, no allocation); the smallest eigenvalue is computed only to report an
 //! unstable equilibrium, or on request ([`stability_margin`]).
+//!
+//! This is the dense path, `O(dof³)`, for any `K_q` and `K_W`: the reference of the structured
+//! `O(dof)` solve that [`crate::ArmStiffness`] uses when `K_q` is block diagonal (see
+//! [`crate::ArmStiffness::evaluate`]). When `K_q + K_W` is exactly symmetric it is solved with
+//! the Cholesky factor already computed for the verdict, else with a partially pivoted LU.
+//! `K_x = C_x⁻¹` comes from a 6 × 6 LU with partial pivoting on the stack, whose pivots also
+//! decide whether `J_x` has full rank ([`RANK_TOLERANCE`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
@@ -35,13 +42,12 @@ pub struct EndStiffnessData {
     sym: Mat<f64>,
     /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6).
     x: Mat<f64>,
-    c_x: Mat<f64>,
-    k_x: Mat<f64>,
-    lu6: Mat<f64>,
+    /// `C_x`, column-major 6 × 6.
+    c_x: [f64; 36],
+    /// `K_x`, column-major 6 × 6.
+    k_x: [f64; 36],
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
-    perm6: Vec<usize>,
-    perm6_inv: Vec<usize>,
     buffer: MemBuffer,
 }
 
@@ -53,45 +59,144 @@ impl EndStiffnessData {
             llt::solve::solve_in_place_scratch::<f64>(dof, 6, Par::Seq),
             lu::factor::lu_in_place_scratch::<usize, f64>(dof, dof, Par::Seq, Default::default()),
             lu::solve::solve_in_place_scratch::<usize, f64>(dof, 6, Par::Seq),
-            lu::factor::lu_in_place_scratch::<usize, f64>(6, 6, Par::Seq, Default::default()),
-            lu::solve::solve_in_place_scratch::<usize, f64>(6, 6, Par::Seq),
         ]);
         EndStiffnessData {
             dof,
             a: Mat::zeros(dof, dof),
             sym: Mat::zeros(dof, dof),
             x: Mat::zeros(dof, 6),
-            c_x: Mat::zeros(6, 6),
-            k_x: Mat::zeros(6, 6),
-            lu6: Mat::zeros(6, 6),
+            c_x: [0.0; 36],
+            k_x: [0.0; 36],
             perm: vec![0; dof],
             perm_inv: vec![0; dof],
-            perm6: vec![0; 6],
-            perm6_inv: vec![0; 6],
             buffer: MemBuffer::new(req),
         }
     }
 
     /// `C_x` (6 × 6, m/N, rad/(N m)) from the last [`end_compliance`].
     pub fn compliance(&self) -> MatRef<'_, f64> {
-        self.c_x.as_ref()
+        MatRef::from_column_major_slice(&self.c_x, 6, 6)
     }
 
     /// `K_x` (6 × 6) from the last [`end_stiffness`].
     pub fn stiffness(&self) -> MatRef<'_, f64> {
-        self.k_x.as_ref()
+        MatRef::from_column_major_slice(&self.k_x, 6, 6)
     }
 
     /// `K_fd = K_x[0:3, 0:3]` (N/m), the paper's translational stiffness (eq. 21): the force
     /// per unit displacement when the end-effector's rotation is held.
     pub fn k_fd(&self) -> Matrix3<f64> {
-        Matrix3::from_fn(|i, j| self.k_x[(i, j)])
+        Matrix3::from_fn(|i, j| self.k_x[i + 6 * j])
     }
 
     /// `(C_x[0:3, 0:3])⁻¹` (N/m): the force per unit displacement when the end-effector is
     /// free to rotate (a pure force applied). `None` when that block is singular.
     pub fn translational_stiffness(&self) -> Option<Matrix3<f64>> {
-        Matrix3::from_fn(|i, j| self.c_x[(i, j)]).try_inverse()
+        Matrix3::from_fn(|i, j| self.c_x[i + 6 * j]).try_inverse()
+    }
+
+    /// Store a compliance computed elsewhere (the structured solve), row-major.
+    pub(crate) fn set_compliance(&mut self, c_x: &[[f64; 6]; 6]) {
+        for (i, row) in c_x.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                self.c_x[i + 6 * j] = *v;
+            }
+        }
+    }
+
+    /// `K_x = C_x⁻¹` (eq. 19) from the stored `C_x`: LU with partial pivoting (6 × 6, on the
+    /// stack), the rank test on its pivots, then the inverse from the factors (`K_x` written
+    /// only when the test passes).
+    ///
+    /// # Errors
+    /// [`StiffnessError::RankDeficient`] when a pivot is below [`RANK_TOLERANCE`] of the
+    /// largest (NaN pivots included).
+    pub(crate) fn invert_compliance(&mut self) -> Result<(), StiffnessError> {
+        const IDENTITY: [[f64; 6]; 6] = [
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        ];
+        // Rows of C_x.
+        let mut u = [[0.0; 6]; 6];
+        for (j, col) in self.c_x.chunks_exact(6).enumerate() {
+            for (i, v) in col.iter().enumerate() {
+                u[i][j] = *v;
+            }
+        }
+        // P C_x = L U by whole-row operations: `u` ends as U (its entries left of the diagonal
+        // are not used), the multipliers go to `l`.
+        let mut l = [[0.0; 6]; 6];
+        let mut perm = [0, 1, 2, 3, 4, 5];
+        let mut inv_pivot = [0.0; 6];
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
+        for c in 0..6 {
+            let mut best = c;
+            for r in c + 1..6 {
+                if u[r][c].abs() > u[best][c].abs() {
+                    best = r;
+                }
+            }
+            if best != c {
+                u.swap(best, c);
+                l.swap(best, c);
+                perm.swap(best, c);
+            }
+            let pivot = u[c][c];
+            (lo, hi) = (lo.min(pivot.abs()), hi.max(pivot.abs()));
+            inv_pivot[c] = 1.0 / pivot;
+            if pivot != 0.0 {
+                let pivot_row = u[c];
+                for r in c + 1..6 {
+                    let f = u[r][c] * inv_pivot[c];
+                    l[r][c] = f;
+                    for (v, p) in u[r].iter_mut().zip(&pivot_row) {
+                        *v -= f * p;
+                    }
+                }
+            }
+        }
+        // Written so that NaN pivots also count as rank-deficient.
+        let full_rank = lo > RANK_TOLERANCE * hi;
+        if !full_rank {
+            return Err(StiffnessError::RankDeficient {
+                pivot_ratio: if hi > 0.0 { lo / hi } else { 0.0 },
+            });
+        }
+        // K_x = U⁻¹ L⁻¹ P, all six columns at once (x[r] is row r of the running solution).
+        let mut x = [[0.0; 6]; 6];
+        for r in 0..6 {
+            let mut row = IDENTITY[perm[r]];
+            for k in 0..r {
+                let f = l[r][k];
+                for (v, xk) in row.iter_mut().zip(&x[k]) {
+                    *v -= f * xk;
+                }
+            }
+            x[r] = row;
+        }
+        for r in (0..6).rev() {
+            let mut row = x[r];
+            for k in r + 1..6 {
+                let f = u[r][k];
+                for (v, xk) in row.iter_mut().zip(&x[k]) {
+                    *v -= f * xk;
+                }
+            }
+            for v in row.iter_mut() {
+                *v *= inv_pivot[r];
+            }
+            x[r] = row;
+        }
+        for (c, col) in self.k_x.chunks_exact_mut(6).enumerate() {
+            for (r, out) in col.iter_mut().enumerate() {
+                *out = x[r][c];
+            }
+        }
+        Ok(())
     }
 }
 
@@ -99,8 +204,8 @@ impl std::fmt::Debug for EndStiffnessData {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("EndStiffnessData")
             .field("dof", &self.dof)
-            .field("c_x", &self.c_x)
-            .field("k_x", &self.k_x)
+            .field("c_x", &self.compliance())
+            .field("k_x", &self.stiffness())
             .finish_non_exhaustive()
     }
 }
@@ -153,25 +258,27 @@ pub fn end_compliance(
         let expected = if j_x.nrows() != 6 { 6 } else { n };
         return Err(StiffnessError::DimensionMismatch { what: "J_x", expected, got });
     }
+    // One pass over both triangles: finiteness, exact symmetry, the symmetric part.
     let mut symmetric = true;
     for j in 0..n {
-        for i in 0..n {
-            let v = k_q[(i, j)] + k_w[(i, j)];
-            if !v.is_finite() {
+        for i in j..n {
+            let l = k_q[(i, j)] + k_w[(i, j)];
+            let u = k_q[(j, i)] + k_w[(j, i)];
+            if !(l.is_finite() && u.is_finite()) {
                 return Err(StiffnessError::NonFinite { what: "K_q + K_W" });
             }
-            data.a[(i, j)] = v;
-        }
-    }
-    for j in 0..n {
-        for i in j..n {
-            let (u, l) = (data.a[(j, i)], data.a[(i, j)]);
-            if u != l {
-                symmetric = false;
-            }
+            symmetric &= u == l;
             let s = 0.5 * (u + l);
             data.sym[(i, j)] = s;
             data.sym[(j, i)] = s;
+        }
+    }
+    if !symmetric {
+        // K_q + K_W itself, for its LU factorisation.
+        for j in 0..n {
+            for i in 0..n {
+                data.a[(i, j)] = k_q[(i, j)] + k_w[(i, j)];
+            }
         }
     }
     let stack = MemStack::new(&mut data.buffer);
@@ -213,7 +320,7 @@ pub fn end_compliance(
         );
     }
     faer::linalg::matmul::matmul(
-        data.c_x.as_mut(),
+        MatMut::from_column_major_slice_mut(&mut data.c_x, 6, 6),
         faer::Accum::Replace,
         j_x,
         data.x.as_ref(),
@@ -224,9 +331,9 @@ pub fn end_compliance(
         // Exact symmetry, as the math says.
         for j in 0..6 {
             for i in j + 1..6 {
-                let s = 0.5 * (data.c_x[(i, j)] + data.c_x[(j, i)]);
-                data.c_x[(i, j)] = s;
-                data.c_x[(j, i)] = s;
+                let s = 0.5 * (data.c_x[i + 6 * j] + data.c_x[j + 6 * i]);
+                data.c_x[i + 6 * j] = s;
+                data.c_x[j + 6 * i] = s;
             }
         }
     }
@@ -247,30 +354,5 @@ pub fn end_stiffness(
     data: &mut EndStiffnessData,
 ) -> Result<(), StiffnessError> {
     end_compliance(k_q, k_w, j_x, data)?;
-    data.lu6.copy_from(data.c_x.as_ref());
-    let stack = MemStack::new(&mut data.buffer);
-    let (_, perm) = lu::factor::lu_in_place(
-        data.lu6.as_mut(),
-        &mut data.perm6,
-        &mut data.perm6_inv,
-        Par::Seq,
-        stack,
-        Default::default(),
-    );
-    let pivots = (0..6).map(|i| data.lu6[(i, i)].abs());
-    let (lo, hi) = pivots.fold((f64::INFINITY, 0.0_f64), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    // Written so that NaN pivots also count as rank-deficient.
-    let full_rank = lo > RANK_TOLERANCE * hi;
-    if !full_rank {
-        return Err(StiffnessError::RankDeficient {
-            pivot_ratio: if hi > 0.0 { lo / hi } else { 0.0 },
-        });
-    }
-    let mut k_x: MatMut<'_, f64> = data.k_x.as_mut();
-    k_x.fill(0.0);
-    for i in 0..6 {
-        k_x[(i, i)] = 1.0;
-    }
-    lu::solve::solve_in_place(data.lu6.as_ref(), data.lu6.as_ref(), perm, k_x, Par::Seq, stack);
-    Ok(())
+    data.invert_compliance()
 }

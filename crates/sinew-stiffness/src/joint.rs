@@ -17,11 +17,12 @@
 //! Each cable's terms are accumulated over its own joint range only (`Cable::dofs`), so the
 //! cost is `O(Σ_c |dofs_c|²)`: linear in the number of joints when decoupled.
 
-use faer::MatMut;
+use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
 use sinew_routing::{Routing, RoutingData};
 
 use crate::error::StiffnessError;
+use crate::structured::{BlockLayout, ColMajor, MAX_BLOCK, zero_blocks};
 
 fn check(what: &'static str, m: &MatMut<'_, f64>, n: usize) -> Result<(), StiffnessError> {
     for got in [m.nrows(), m.ncols()] {
@@ -63,7 +64,151 @@ pub fn joint_stiffness(
     Ok(())
 }
 
-/// `out += J_cᵀ K_l J_c`, cable by cable over each cable's joint range.
+/// `Σ_c f_c H_c`, `J_cᵀ K_l J_c` and their sum `K_q` into three dof × dof matrices, block by
+/// block of `layout` (which every cable of `routing` fits in): only the entries inside the
+/// blocks are written, the caller keeps the others at zero. Small blocks
+/// ([`BlockLayout::structured`]) are accumulated on the stack, segment by segment and cable by
+/// cable in routing order (the sums of [`joint_stiffness`], term for term); large ones (the
+/// routed model) through [`joint_stiffness`]'s own loops. `O(Σ_c |dofs_c|²)`, no allocation.
+pub(crate) fn joint_stiffness_in_blocks(
+    routing: &Routing,
+    geometry: &RoutingData,
+    tensions: &[f64],
+    layout: &BlockLayout,
+    controllable: &mut ColMajor,
+    inherent: &mut ColMajor,
+    k_q: &mut ColMajor,
+) -> Result<(), StiffnessError> {
+    let n = routing.dof();
+    check("controllable stiffness", &controllable.as_mut(), n)?;
+    check("inherent stiffness", &inherent.as_mut(), n)?;
+    check("K_q", &k_q.as_mut(), n)?;
+    if tensions.len() != routing.cable_count() {
+        return Err(StiffnessError::DimensionMismatch {
+            what: "tensions",
+            expected: routing.cable_count(),
+            got: tensions.len(),
+        });
+    }
+    if !layout.structured() {
+        zero_blocks(layout, controllable.as_mut());
+        geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
+        zero_blocks(layout, inherent.as_mut());
+        add_inherent(routing, geometry, inherent.as_mut())?;
+        for block in layout.blocks() {
+            for j in block.clone() {
+                for i in block.clone() {
+                    *k_q.at_mut(i, j) = controllable.at(i, j) + inherent.at(i, j);
+                }
+            }
+        }
+        return Ok(());
+    }
+    let j_c = geometry.jacobian()?;
+    for (k, block) in layout.blocks().enumerate() {
+        let cables = layout.cables_of(k);
+        let args = (routing, geometry, j_c, tensions, cables, block.start);
+        let parts = &mut (&mut *controllable, &mut *inherent, &mut *k_q);
+        match block.len() {
+            1 => block_stiffness::<1>(args, parts)?,
+            2 => block_stiffness::<2>(args, parts)?,
+            3 => block_stiffness::<3>(args, parts)?,
+            4 => block_stiffness::<4>(args, parts)?,
+            got => {
+                return Err(StiffnessError::DimensionMismatch {
+                    what: "joint stiffness block",
+                    expected: MAX_BLOCK,
+                    got,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One `B × B` block of [`joint_stiffness_in_blocks`]: its cables' `f_c H_c` (segment by
+/// segment) and `k_c J_cᵀ J_c` (each product once, both triangles), then the three matrices.
+#[inline(always)]
+fn block_stiffness<const B: usize>(
+    (routing, geometry, j_c, tensions, cables, lo): (
+        &Routing,
+        &RoutingData,
+        MatRef<'_, f64>,
+        &[f64],
+        &[usize],
+        usize,
+    ),
+    (controllable, inherent, k_q): &mut (&mut ColMajor, &mut ColMajor, &mut ColMajor),
+) -> Result<(), StiffnessError> {
+    let mut kc = [[0.0; B]; B];
+    let mut ki = [[0.0; B]; B];
+    let segments = routing.segments();
+    for &c in cables {
+        let Some(cable) = routing.cables().get(c) else { continue };
+        let (f, k) = (tensions[c], cable.stiffness);
+        for s in cable.segments.clone() {
+            let Some(seg) = segments.get(s) else { continue };
+            let (o, span) = (seg.dofs.start.wrapping_sub(lo), seg.dofs.len());
+            if span == 0 || o + span > B {
+                continue;
+            }
+            let h = geometry.segment_hessian(routing, s)?;
+            if span == B {
+                // The common case (a segment across the whole block): fixed bounds.
+                for kk in 0..B {
+                    for i in 0..B {
+                        kc[i][kk] += f * h[(i, kk)];
+                    }
+                }
+            } else {
+                for kk in 0..span {
+                    for i in 0..span {
+                        kc[o + i][o + kk] += f * h[(i, kk)];
+                    }
+                }
+            }
+        }
+        let (o, span) = (cable.dofs.start.wrapping_sub(lo), cable.dofs.len());
+        if span == 0 || o + span > B {
+            continue;
+        }
+        // J_c[c, ·] over the block (exact zeros outside the cable's DOFs).
+        let mut row = [0.0; B];
+        for (r, v) in row.iter_mut().enumerate() {
+            if r >= o && r < o + span {
+                *v = j_c[(c, lo + r)];
+            }
+        }
+        for j in 0..B {
+            let kj = k * row[j];
+            for i in 0..j {
+                let v = kj * row[i];
+                ki[i][j] += v;
+                ki[j][i] += v;
+            }
+            ki[j][j] += kj * row[j];
+        }
+    }
+    for cc in 0..B {
+        let col = &mut controllable.col_mut(lo + cc)[lo..lo + B];
+        for r in 0..B {
+            col[r] = kc[r][cc];
+        }
+        let col = &mut inherent.col_mut(lo + cc)[lo..lo + B];
+        for r in 0..B {
+            col[r] = ki[r][cc];
+        }
+        let col = &mut k_q.col_mut(lo + cc)[lo..lo + B];
+        for r in 0..B {
+            col[r] = kc[r][cc] + ki[r][cc];
+        }
+    }
+    Ok(())
+}
+
+/// `out += J_cᵀ K_l J_c`, cable by cable over each cable's joint range, column by column;
+/// entry `(i, j)` is `(k_c J_c[c, max(i, j)]) · J_c[c, min(i, j)]`, so the result is exactly
+/// symmetric.
 fn add_inherent(
     routing: &Routing,
     geometry: &RoutingData,
@@ -73,9 +218,13 @@ fn add_inherent(
     for (c, cable) in routing.cables().iter().enumerate() {
         let k = cable.stiffness;
         for j in cable.dofs.clone() {
-            let kj = k * j_c[(c, j)];
-            for i in cable.dofs.clone() {
+            let jj = j_c[(c, j)];
+            let kj = k * jj;
+            for i in cable.dofs.start..=j {
                 out[(i, j)] += kj * j_c[(c, i)];
+            }
+            for i in j + 1..cable.dofs.end {
+                out[(i, j)] += (k * j_c[(c, i)]) * jj;
             }
         }
     }
@@ -105,7 +254,7 @@ pub fn stiffness_slope(
 
 /// The 2 × 2 block of universal joint `i` in a dof × dof stiffness matrix:
 /// `[[K_{i,x}, ·], [·, K_{i,y}]]`.
-pub fn joint_block(k: faer::MatRef<'_, f64>, i: usize) -> Option<Matrix2<f64>> {
+pub fn joint_block(k: MatRef<'_, f64>, i: usize) -> Option<Matrix2<f64>> {
     if 2 * i + 1 >= k.nrows().min(k.ncols()) {
         return None;
     }

@@ -15,8 +15,9 @@ mod arm;
 mod end;
 mod error;
 mod joint;
+mod structured;
 
-pub use arm::{ArmStiffness, ArmStiffnessData};
+pub use arm::{ArmStiffness, ArmStiffnessData, EndSolver};
 pub use end::{EndStiffnessData, RANK_TOLERANCE, end_compliance, end_stiffness, stability_margin};
 pub use error::StiffnessError;
 pub use joint::{joint_block, joint_stiffness, stiffness_slope};

@@ -1,0 +1,465 @@
+//! The structured `O(dof)` end solve of the decoupled model against the dense reference
+//! (faer's Cholesky/LU of `K_q + K_W`, with `K_W` from sinew-statics'
+//! `equilibrium_torque_derivative`): `C_x`, `K_x`, the stability verdict and the reported
+//! smallest eigenvalue, on cdhrm5 and generated chains of 5, 25 and 100 universal joints,
+//! gravity on and off, `F0` zero, a force, a force and a moment; unstable and rank-deficient
+//! equilibria; and which solver ran.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use faer::{Mat, MatRef};
+use nalgebra::{Vector3, Vector6};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use sinew_robot::{Robot, RobotData, UniformChain};
+use sinew_routing::{PatternModel, Routing, RoutingSpec};
+use sinew_statics::{JointEndData, equilibrium_torque_derivative};
+use sinew_stiffness::{
+    ArmStiffness, ArmStiffnessData, EndSolver, EndStiffnessData, StiffnessError, end_stiffness,
+};
+
+const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+
+/// Relative agreement required between the structured solve and the dense reference.
+const RTOL: f64 = 1e-10;
+
+/// The kinds of load `F0` exerted by the end-effector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Load {
+    Zero,
+    Force,
+    ForceAndMoment,
+}
+
+/// A decoupled arm and the scale of its loads: gravity (m/s²) and tip force (N) that the
+/// cables can hold (long chains carry little: `[20, 600]` N on a 22 mm hole circle).
+struct Setup {
+    name: String,
+    robot: Robot,
+    routing: Routing,
+    gravity: f64,
+    force: f64,
+    /// Fraction of the joint limits the random configurations use.
+    reach: f64,
+}
+
+fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
+    let chain = UniformChain::like_cdhrm5(joints);
+    let robot = chain.build().unwrap();
+    let routing =
+        Routing::new(&robot, &RoutingSpec::for_uniform_chain(&chain, model), "<test>").unwrap();
+    (robot, routing)
+}
+
+fn setups() -> Vec<Setup> {
+    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let mut v = vec![Setup {
+        name: "cdhrm5".into(),
+        robot,
+        routing,
+        gravity: 9.81,
+        force: 5.0,
+        reach: 1.0,
+    }];
+    for (joints, gravity, force, reach) in
+        [(5, 9.81, 5.0, 1.0), (25, 0.05, 0.1, 0.3), (100, 0.0005, 0.01, 0.1)]
+    {
+        let (robot, routing) = chain(joints, PatternModel::Decoupled);
+        v.push(Setup { name: format!("uniform{joints}"), robot, routing, gravity, force, reach });
+    }
+    v
+}
+
+fn max_abs(m: MatRef<'_, f64>) -> f64 {
+    let mut x: f64 = 0.0;
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            x = x.max(m[(i, j)].abs());
+        }
+    }
+    x
+}
+
+/// `max |a − b| / max |b|` (0 when both vanish).
+fn rel_err(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
+    let diff = max_abs((a.to_owned() - b).as_ref());
+    if diff == 0.0 { 0.0 } else { diff / max_abs(b) }
+}
+
+/// The dense reference at the configuration last evaluated in `data`: `K_W` from
+/// `equilibrium_torque_derivative` (independent of the generators), then `end_stiffness`.
+fn reference(
+    robot: &Robot,
+    q: &[f64],
+    f0: &Vector6<f64>,
+    data: &ArmStiffnessData,
+) -> (Mat<f64>, EndStiffnessData, Result<(), StiffnessError>) {
+    let n = robot.dof();
+    let mut rdata = RobotData::new(robot);
+    robot.forward_kinematics(&mut rdata, q).unwrap();
+    let mut k_w = Mat::zeros(n, n);
+    equilibrium_torque_derivative(
+        robot,
+        &mut rdata,
+        &mut JointEndData::new(robot),
+        f0,
+        k_w.as_mut(),
+    )
+    .unwrap();
+    let mut end = EndStiffnessData::new(n);
+    let outcome = end_stiffness(data.k_q(), k_w.as_ref(), data.j_x(), &mut end);
+    (k_w, end, outcome)
+}
+
+/// Compares one evaluation with the dense reference; returns the verdict's name.
+fn compare(
+    label: &str,
+    robot: &Robot,
+    q: &[f64],
+    f0: &Vector6<f64>,
+    data: &ArmStiffnessData,
+    outcome: &Result<(), StiffnessError>,
+) -> &'static str {
+    compare_with_errors(label, robot, q, f0, data, outcome).0
+}
+
+/// As [`compare`], with the relative errors of `C_x` and `K_x` (zero when not compared).
+fn compare_with_errors(
+    label: &str,
+    robot: &Robot,
+    q: &[f64],
+    f0: &Vector6<f64>,
+    data: &ArmStiffnessData,
+    outcome: &Result<(), StiffnessError>,
+) -> (&'static str, f64, f64) {
+    let (k_w, end, expected) = reference(robot, q, f0, data);
+    let err = rel_err(data.k_w(), k_w.as_ref());
+    assert!(err <= 1e-12, "{label}: K_W from the generators off by {err:e}");
+    match (outcome, &expected) {
+        (Ok(()), Ok(())) => {
+            assert_eq!(data.end_solver(), EndSolver::Structured, "{label}: fast path not taken");
+            let c_err = rel_err(data.compliance(), end.compliance());
+            assert!(c_err <= RTOL, "{label}: C_x off by {c_err:e}");
+            let k_err = rel_err(data.stiffness(), end.stiffness());
+            assert!(k_err <= RTOL, "{label}: K_x off by {k_err:e}");
+            assert!(
+                data.structured_backward_error() <= 1e-14,
+                "{label}: backward error {:e}",
+                data.structured_backward_error()
+            );
+            ("stable", c_err, k_err)
+        }
+        (
+            Err(StiffnessError::Unstable { min_eigenvalue: got }),
+            Err(StiffnessError::Unstable { min_eigenvalue: want }),
+        ) => {
+            assert_eq!(data.end_solver(), EndSolver::Dense, "{label}: unstable goes dense");
+            let err = (got - want).abs() / want.abs();
+            assert!(err <= RTOL, "{label}: smallest eigenvalue {got} vs {want}");
+            ("unstable", 0.0, 0.0)
+        }
+        (
+            Err(StiffnessError::RankDeficient { pivot_ratio: got }),
+            Err(StiffnessError::RankDeficient { pivot_ratio: want }),
+        ) => {
+            assert_eq!(data.end_solver(), EndSolver::Structured, "{label}: fast path not taken");
+            assert!(*got <= 1e-10 && *want <= 1e-10, "{label}: pivot ratios {got:e}, {want:e}");
+            // The compliance is kept, and agrees (relative to its size).
+            let err = rel_err(data.compliance(), end.compliance());
+            assert!(err <= RTOL, "{label}: C_x off by {err:e}");
+            ("rank-deficient", err, 0.0)
+        }
+        (got, want) => panic!("{label}: structured {got:?}, dense reference {want:?}"),
+    }
+}
+
+fn random_load(rng: &mut ChaCha8Rng, kind: Load, force: f64) -> Vector6<f64> {
+    let mut f0 = Vector6::zeros();
+    if kind != Load::Zero {
+        for k in 0..3 {
+            f0[k] = rng.random_range(-force..force);
+        }
+    }
+    if kind == Load::ForceAndMoment {
+        // A moment of the size of the force times 0.1 m.
+        for k in 3..6 {
+            f0[k] = rng.random_range(-0.1 * force..0.1 * force);
+        }
+    }
+    f0
+}
+
+#[test]
+fn the_structured_solve_matches_the_dense_reference() {
+    for (index, setup) in setups().into_iter().enumerate() {
+        let Setup { name, robot: base, routing, gravity, force, reach } = setup;
+        let model = ArmStiffness::new(&routing).unwrap();
+        let joints = base.dof() / 2;
+        for gravity_on in [true, false] {
+            let g = if gravity_on {
+                Vector3::new(0.3, 1.0, -0.2).normalize() * gravity
+            } else {
+                Vector3::zeros()
+            };
+            let robot = base.with_gravity(g);
+            let mut data = model.data(&robot, &routing);
+            for kind in [Load::Zero, Load::Force, Load::ForceAndMoment] {
+                let mut rng = ChaCha8Rng::seed_from_u64(71 + index as u64);
+                let (mut checked, mut infeasible, mut stable) = (0, 0, 0);
+                let (mut worst_c, mut worst_k): (f64, f64) = (0.0, 0.0);
+                // Stable equilibria (the fast path's results) wanted, per gravity and load.
+                let wanted = if joints >= 100 { 20 } else { 40 };
+                let mut tries = 0;
+                while stable < wanted {
+                    tries += 1;
+                    assert!(
+                        tries < 100 * wanted,
+                        "{name} gravity={gravity_on} {kind:?}: {stable} stable of {checked} \
+                         ({infeasible} infeasible)"
+                    );
+                    let q: Vec<f64> = robot
+                        .joints()
+                        .iter()
+                        .map(|j| reach * rng.random_range(j.lower..=j.upper))
+                        .collect();
+                    let levels: Vec<f64> =
+                        (0..joints).map(|_| rng.random_range(0.0..=1.0)).collect();
+                    let f0 = random_load(&mut rng, kind, force);
+                    let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels);
+                    if let Err(StiffnessError::Statics(_)) = outcome {
+                        infeasible += 1;
+                        continue;
+                    }
+                    let label = format!("{name} g={gravity_on} {kind:?} #{checked}");
+                    let (verdict, c_err, k_err) =
+                        compare_with_errors(&label, &robot, &q, &f0, &data, &outcome);
+                    if verdict == "stable" {
+                        stable += 1;
+                    }
+                    (worst_c, worst_k) = (worst_c.max(c_err), worst_k.max(k_err));
+                    checked += 1;
+                }
+                println!(
+                    "{name} gravity={gravity_on} {kind:?}: {checked} checked ({stable} stable), \
+                     {infeasible} infeasible; worst relative error C_x {worst_c:.1e}, \
+                     K_x {worst_k:.1e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
+    // A compressive tip force along the straight-ish arm buckles it: K_W (negative) beats the
+    // cables' stiffness at low tension levels. Forces from small to large give both verdicts.
+    let mut unstable = 0;
+    let mut stable = 0;
+    for (name, robot, routing) in [
+        {
+            let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            ("cdhrm5", robot, routing)
+        },
+        {
+            let (robot, routing) = chain(5, PatternModel::Decoupled);
+            ("uniform5", robot, routing)
+        },
+    ] {
+        let robot = robot.with_gravity(Vector3::zeros());
+        let model = ArmStiffness::new(&routing).unwrap();
+        let mut data = model.data(&robot, &routing);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for step in 0..60 {
+            let q: Vec<f64> = (0..robot.dof()).map(|_| rng.random_range(-0.05..0.05)).collect();
+            let push = 2.0 * step as f64;
+            for f0 in [
+                Vector6::new(0.0, 0.0, push, 0.0, 0.0, 0.0),
+                Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.0),
+                Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.05 * push),
+            ] {
+                let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.0; 5]);
+                if let Err(StiffnessError::Statics(_)) = outcome {
+                    continue;
+                }
+                match compare(&format!("{name} push {push}"), &robot, &q, &f0, &data, &outcome) {
+                    "unstable" => unstable += 1,
+                    "stable" => stable += 1,
+                    _ => {}
+                }
+            }
+        }
+    }
+    println!("{unstable} unstable, {stable} stable");
+    assert!(unstable >= 20 && stable >= 20, "{unstable} unstable, {stable} stable");
+}
+
+#[test]
+fn a_straight_arm_is_rank_deficient_on_both_paths() {
+    // Universal joints about x and y cannot turn a straight arm about its own axis: J_x has
+    // rank 5 at Q = 0, C_x is singular, K_x does not exist.
+    for (name, robot, routing) in [
+        {
+            let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            ("cdhrm5", robot.with_gravity(Vector3::zeros()), routing)
+        },
+        {
+            let (robot, routing) = chain(25, PatternModel::Decoupled);
+            ("uniform25", robot.with_gravity(Vector3::zeros()), routing)
+        },
+    ] {
+        let model = ArmStiffness::new(&routing).unwrap();
+        let mut data = model.data(&robot, &routing);
+        let q = vec![0.0; robot.dof()];
+        let levels = vec![0.3; robot.dof() / 2];
+        for f0 in [Vector6::zeros(), Vector6::new(0.0, 0.0, -1.0, 0.0, 0.0, 0.0)] {
+            let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels);
+            assert!(
+                matches!(outcome, Err(StiffnessError::RankDeficient { .. })),
+                "{name}: {outcome:?}"
+            );
+            assert_eq!(compare(name, &robot, &q, &f0, &data, &outcome), "rank-deficient");
+            // No rotation about z: the last row and column of C_x vanish (to rounding).
+            let c = data.compliance();
+            assert!(c[(5, 5)].abs() <= 1e-12 * max_abs(c), "{name}: C_x[5,5] = {:e}", c[(5, 5)]);
+        }
+    }
+}
+
+#[test]
+fn the_routed_model_and_the_dense_reference_are_the_same_path() {
+    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables-routed.toml"), &robot).unwrap();
+    let model = ArmStiffness::new(&routing).unwrap();
+    let mut data = model.data(&robot, &routing);
+    assert_eq!(data.end_solver(), EndSolver::NotYet);
+    let pi = std::f64::consts::PI;
+    let q = [
+        -pi / 7.0,
+        -pi / 9.0,
+        -pi / 9.0,
+        -pi / 11.0,
+        pi / 6.0,
+        pi / 7.0,
+        pi / 8.0,
+        -pi / 15.0,
+        -pi / 12.0,
+        -pi / 10.0,
+    ];
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]);
+    // K_q is full (a cable crosses every proximal joint): the dense path.
+    assert_eq!(data.end_solver(), EndSolver::Dense);
+    let (_, end, expected) = reference(&robot, &q, &f0, &data);
+    assert_eq!(outcome.is_ok(), expected.is_ok());
+    assert!(rel_err(data.compliance(), end.compliance()) <= RTOL);
+    // The decoupled routing of the same robot takes the structured path.
+    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let model = ArmStiffness::new(&routing).unwrap();
+    let mut data = model.data(&robot, &routing);
+    model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]).unwrap();
+    assert_eq!(data.end_solver(), EndSolver::Structured);
+}
+
+#[test]
+fn k_q_outside_the_joint_blocks_stays_exactly_zero() {
+    // The fast path writes only the joints' 2 × 2 blocks of the three joint-stiffness matrices;
+    // the rest must stay zero across evaluations, and K_q must equal the public
+    // `joint_stiffness` sum.
+    let (robot, routing) = chain(25, PatternModel::Decoupled);
+    let robot = robot.with_gravity(Vector3::new(0.0, 0.3, 0.0));
+    let model = ArmStiffness::new(&routing).unwrap();
+    let mut data = model.data(&robot, &routing);
+    let n = robot.dof();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    for _ in 0..10 {
+        let q: Vec<f64> = (0..n).map(|_| rng.random_range(-0.1..0.1)).collect();
+        let levels: Vec<f64> = (0..n / 2).map(|_| rng.random_range(0.0..1.0)).collect();
+        model.joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        let mut kc = Mat::<f64>::zeros(n, n);
+        let mut ki = Mat::<f64>::zeros(n, n);
+        sinew_stiffness::joint_stiffness(
+            &routing,
+            &data.cables,
+            data.tensions(),
+            kc.as_mut(),
+            ki.as_mut(),
+        )
+        .unwrap();
+        assert_eq!(data.k_controllable().to_owned(), kc);
+        assert_eq!(data.k_inherent().to_owned(), ki);
+        assert_eq!(data.k_q().to_owned(), &kc + &ki);
+    }
+}
+
+#[test]
+fn the_generators_rebuild_k_w_and_j_x() {
+    // sinew-robot's generators against its dense derivatives, and the pipeline's J_x against
+    // `point_jacobian` (the same arithmetic: equal to the last bit).
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    for setup in setups() {
+        let robot = &setup.robot;
+        let n = robot.dof();
+        let model = ArmStiffness::new(&setup.routing).unwrap();
+        let mut data = model.data(robot, &setup.routing);
+        let mut rdata = RobotData::new(robot);
+        let tip = robot.tip_point();
+        for _ in 0..20 {
+            let q: Vec<f64> = robot
+                .joints()
+                .iter()
+                .map(|j| setup.reach * rng.random_range(j.lower..=j.upper))
+                .collect();
+            let f0 = Vector6::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            robot.forward_kinematics(&mut rdata, &q).unwrap();
+            // Gravity: ∂T_g[j]/∂q_i = a_min · u_max.
+            let mut u = vec![Vector3::zeros(); n];
+            robot.gravity_torque_derivative_generators(&mut rdata, &mut u).unwrap();
+            let mut dense = Mat::zeros(n, n);
+            robot.gravity_torque_derivative(&mut rdata, dense.as_mut()).unwrap();
+            let axes: Vec<Vector3<f64>> = (0..n).map(|k| *rdata.joint_axis(k).unwrap()).collect();
+            let axis = |k: usize| axes[k];
+            let from_generators = Mat::from_fn(n, n, |j, i| axis(i.min(j)).dot(&u[i.max(j)]));
+            let err = rel_err(from_generators.as_ref(), dense.as_ref());
+            assert!(err <= 1e-13, "{}: gravity generators off by {err:e}", setup.name);
+            // Load: a_i · lower_j (i ≤ j), a_j · upper_i (i > j).
+            let (mut upper, mut lower) = (vec![Vector3::zeros(); n], vec![Vector3::zeros(); n]);
+            robot
+                .wrench_torque_derivative_generators(&rdata, &tip, &f0, &mut upper, &mut lower)
+                .unwrap();
+            robot.wrench_torque_derivative(&mut rdata, &tip, &f0, dense.as_mut()).unwrap();
+            let from_generators = Mat::from_fn(n, n, |j, i| {
+                if i <= j { axis(i).dot(&lower[j]) } else { axis(j).dot(&upper[i]) }
+            });
+            let err = rel_err(from_generators.as_ref(), dense.as_ref());
+            assert!(err <= 1e-13, "{}: wrench generators off by {err:e}", setup.name);
+            // Partial velocities: the linear rows of the point Jacobian.
+            let mut v = vec![Vector3::zeros(); n];
+            robot.point_partial_velocities(&rdata, &tip, &mut v).unwrap();
+            let mut j_x = Mat::zeros(6, n);
+            robot.point_jacobian(&rdata, &tip, j_x.as_mut()).unwrap();
+            for k in 0..n {
+                for r in 0..3 {
+                    assert_eq!(v[k][r], j_x[(r, k)]);
+                }
+            }
+            // The pipeline: J_x exactly, K_W to rounding.
+            let levels = vec![0.5; n / 2];
+            if model.joint_level(robot, &setup.routing, &mut data, &q, &f0, &levels).is_ok() {
+                assert_eq!(data.j_x().to_owned(), j_x, "{}: J_x", setup.name);
+                let mut k_w = Mat::zeros(n, n);
+                equilibrium_torque_derivative(
+                    robot,
+                    &mut rdata,
+                    &mut JointEndData::new(robot),
+                    &f0,
+                    k_w.as_mut(),
+                )
+                .unwrap();
+                let err = rel_err(data.k_w(), k_w.as_ref());
+                assert!(err <= 1e-13, "{}: K_W off by {err:e}", setup.name);
+            }
+        }
+    }
+}
