@@ -23,7 +23,7 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting as lu;
-use faer::{Mat, MatMut, MatRef, Par, Side};
+use faer::{Mat, MatRef, Par, Side};
 use nalgebra::Matrix3;
 
 use crate::error::StiffnessError;
@@ -319,14 +319,19 @@ pub fn end_compliance(
             stack,
         );
     }
-    faer::linalg::matmul::matmul(
-        MatMut::from_column_major_slice_mut(&mut data.c_x, 6, 6),
-        faer::Accum::Replace,
-        j_x,
-        data.x.as_ref(),
-        1.0,
-        Par::Seq,
-    );
+    // C_x = J_x X: 36 dof multiply-adds in plain loops. (faer's matmul here returned with the
+    // vector registers' upper halves dirty on the project machine, which slowed the scalar code
+    // of the next evaluation threefold; see docs/performance.md.)
+    for (c, out) in data.c_x.chunks_exact_mut(6).enumerate() {
+        let mut col = [0.0; 6];
+        for k in 0..n {
+            let x = data.x[(k, c)];
+            for (r, v) in col.iter_mut().enumerate() {
+                *v += j_x[(r, k)] * x;
+            }
+        }
+        out.copy_from_slice(&col);
+    }
     if symmetric {
         // Exact symmetry, as the math says.
         for j in 0..6 {

@@ -17,6 +17,8 @@
 //! Each cable's terms are accumulated over its own joint range only (`Cable::dofs`), so the
 //! cost is `O(Σ_c |dofs_c|²)`: linear in the number of joints when decoupled.
 
+use std::ops::Range;
+
 use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
 use sinew_routing::{Routing, RoutingData};
@@ -60,7 +62,8 @@ pub fn joint_stiffness(
     controllable.fill(0.0);
     geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
     inherent.fill(0.0);
-    add_inherent(routing, geometry, inherent.as_mut())?;
+    add_inherent_upper(routing, geometry, inherent.as_mut())?;
+    mirror_upper(inherent, std::iter::once(0..n));
     Ok(())
 }
 
@@ -91,10 +94,11 @@ pub(crate) fn joint_stiffness_in_blocks(
         });
     }
     if !layout.structured() {
-        zero_blocks(layout, controllable.as_mut());
+        zero_blocks(layout, controllable);
         geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
-        zero_blocks(layout, inherent.as_mut());
-        add_inherent(routing, geometry, inherent.as_mut())?;
+        zero_blocks(layout, inherent);
+        add_inherent_upper(routing, geometry, inherent.as_mut())?;
+        mirror_upper(inherent.as_mut(), layout.blocks());
         for block in layout.blocks() {
             for j in block.clone() {
                 for i in block.clone() {
@@ -206,10 +210,10 @@ fn block_stiffness<const B: usize>(
     Ok(())
 }
 
-/// `out += J_cᵀ K_l J_c`, cable by cable over each cable's joint range, column by column;
-/// entry `(i, j)` is `(k_c J_c[c, max(i, j)]) · J_c[c, min(i, j)]`, so the result is exactly
-/// symmetric.
-fn add_inherent(
+/// `out += J_cᵀ K_l J_c` on and above the diagonal, cable by cable over each cable's joint
+/// range, column by column: entry `(i, j)`, `i ≤ j`, gets `(k_c J_c[c, j]) · J_c[c, i]`. The
+/// caller mirrors the result ([`mirror_upper`]) into an exactly symmetric matrix.
+fn add_inherent_upper(
     routing: &Routing,
     geometry: &RoutingData,
     mut out: MatMut<'_, f64>,
@@ -218,17 +222,24 @@ fn add_inherent(
     for (c, cable) in routing.cables().iter().enumerate() {
         let k = cable.stiffness;
         for j in cable.dofs.clone() {
-            let jj = j_c[(c, j)];
-            let kj = k * jj;
+            let kj = k * j_c[(c, j)];
             for i in cable.dofs.start..=j {
                 out[(i, j)] += kj * j_c[(c, i)];
-            }
-            for i in j + 1..cable.dofs.end {
-                out[(i, j)] += (k * j_c[(c, i)]) * jj;
             }
         }
     }
     Ok(())
+}
+
+/// Copy the strict upper triangle of each diagonal block `blocks` of `out` to its lower one.
+fn mirror_upper(mut out: MatMut<'_, f64>, blocks: impl Iterator<Item = Range<usize>>) {
+    for block in blocks {
+        for j in block.clone() {
+            for i in j + 1..block.end {
+                out[(i, j)] = out[(j, i)];
+            }
+        }
+    }
 }
 
 /// `Σ_c δf_c H_c`: how the joint stiffness changes when the tensions change by `δf` (the

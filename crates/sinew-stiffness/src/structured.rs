@@ -1062,12 +1062,10 @@ fn check(layout: &BlockLayout, gens: &KwGenerators, data: &mut StructuredData) -
 }
 
 /// Zero the entries of `m` inside the blocks of `layout`.
-pub(crate) fn zero_blocks(layout: &BlockLayout, mut m: MatMut<'_, f64>) {
+pub(crate) fn zero_blocks(layout: &BlockLayout, m: &mut ColMajor) {
     for block in layout.blocks() {
         for c in block.clone() {
-            for r in block.clone() {
-                m[(r, c)] = 0.0;
-            }
+            m.col_mut(c)[block.clone()].fill(0.0);
         }
     }
 }

@@ -349,8 +349,11 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     ];
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]);
-    // K_q is full (a cable crosses every proximal joint): the dense path.
+    // K_q is full (a cable crosses every proximal joint): the dense path. It is exactly
+    // symmetric (each product of J_cᵀ K_l J_c computed once), so with a pure force the dense
+    // path solves with the Cholesky factor of its verdict.
     assert_eq!(data.end_solver(), EndSolver::Dense);
+    assert_eq!(data.k_q().to_owned(), data.k_q().transpose().to_owned());
     let (_, end, expected) = reference(&robot, &q, &f0, &data);
     assert_eq!(outcome.is_ok(), expected.is_ok());
     assert!(rel_err(data.compliance(), end.compliance()) <= RTOL);
