@@ -1,6 +1,7 @@
 //! `cargo xtask <command>`: project automation.
 //!
-//! - `reproduce`: every table and figure of the paper, from the robot files in `robots/`.
+//! - `reproduce [--check]`: every table and figure of the paper, from the robot files in
+//!   `robots/`; `--check` fails when the committed `docs/reproduction/` is stale.
 //! - `gen-chain`: write the URDF of a uniform chain of universal joints.
 
 use std::path::{Path, PathBuf};
@@ -15,7 +16,8 @@ type DynResult<T> = Result<T, Box<dyn std::error::Error>>;
 const USAGE: &str = "usage: cargo xtask <command>
 
 commands:
-  reproduce                       every table and figure of the paper (robots/cdhrm5) into docs/reproduction/
+  reproduce [--check]             every table and figure of the paper (robots/cdhrm5) into docs/reproduction/;
+                                  --check: write them under target/ and fail if the committed ones differ
   gen-chain --joints N --out FILE [--name NAME] [--d1 M] [--d2 M] [--link-length M]
             [--link-radius M] [--mass-per-link KG] [--limit RAD]
                                   write the URDF of a uniform chain of universal joints
@@ -24,7 +26,7 @@ commands:
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
-        Some("reproduce") => reproduce::run(&project_root()),
+        Some("reproduce") => reproduce::run(&project_root(), &args[1..]),
         Some("gen-chain") => gen_chain(&args[1..]),
         Some("calibrate") => calibrate::run(&args[1..]),
         Some("-h" | "--help") | None => {

@@ -1,5 +1,7 @@
 //! `cargo xtask reproduce`: every table and figure of the paper from `robots/cdhrm5`, written
-//! to `docs/reproduction/`.
+//! to `docs/reproduction/`. With `--check` it writes them to `target/reproduce-check/` instead
+//! and fails unless every file equals the committed one (the SVGs included, which the snapshot
+//! tests do not cover).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -39,9 +41,47 @@ impl Output {
     }
 }
 
-pub fn run(root: &Path) -> DynResult<()> {
+/// Where the report is committed, relative to the workspace root.
+const REPORT_DIR: &str = "docs/reproduction";
+
+/// `cargo xtask reproduce [--check]`.
+pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
+    let check = match args {
+        [] => false,
+        [flag] if flag == "--check" => true,
+        _ => return Err(format!("reproduce takes no arguments but --check, got {args:?}").into()),
+    };
+    let dir = if check { root.join("target/reproduce-check") } else { root.join(REPORT_DIR) };
+    let written = write_report(root, dir)?;
+    if check {
+        let stale: Vec<String> = written
+            .iter()
+            .filter_map(|fresh| {
+                let name = fresh.file_name()?;
+                let committed = root.join(REPORT_DIR).join(name);
+                let same = matches!(
+                    (std::fs::read(fresh), std::fs::read(&committed)),
+                    (Ok(a), Ok(b)) if a == b
+                );
+                (!same).then(|| format!("{REPORT_DIR}/{}", name.to_string_lossy()))
+            })
+            .collect();
+        if !stale.is_empty() {
+            return Err(format!(
+                "stale or missing: {}; run `cargo xtask reproduce` and commit {REPORT_DIR}/",
+                stale.join(", ")
+            )
+            .into());
+        }
+        println!("{REPORT_DIR}/ is up to date ({} files compared)", written.len());
+    }
+    Ok(())
+}
+
+/// Compute everything and write the report into `dir`; returns the files written.
+fn write_report(root: &Path, dir: PathBuf) -> DynResult<Vec<PathBuf>> {
     let robot_dir = root.join("robots/cdhrm5");
-    let mut out = Output { dir: root.join("docs/reproduction"), written: Vec::new() };
+    let mut out = Output { dir, written: Vec::new() };
     std::fs::create_dir_all(&out.dir)?;
 
     let started = Instant::now();
@@ -155,5 +195,5 @@ pub fn run(root: &Path) -> DynResult<()> {
     for path in &out.written {
         println!("  {}", path.strip_prefix(root).unwrap_or(path).display());
     }
-    Ok(())
+    Ok(out.written)
 }
