@@ -201,9 +201,9 @@ impl JointProbe {
                 self.inherent.as_mut(),
             )?;
             let kc = joint_block(self.controllable.as_ref(), i)
-                .ok_or(IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
+                .ok_or_else(|| IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
             let ki = joint_block(self.inherent.as_ref(), i)
-                .ok_or(IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
+                .ok_or_else(|| IndicatorError::NoSuchJoint { joint: i, joints: robot.dof() / 2 })?;
             controllable[end] = kc;
             inherent = ki;
             ends[end] = kc + ki;

@@ -19,7 +19,7 @@
 //! which is also the second derivative of the point, `∂²p/∂q_i∂q_j = a_min × v_max`.
 
 use faer::MatMut;
-use nalgebra::{IsometryMatrix3, Vector3, Vector6};
+use nalgebra::{IsometryMatrix3, Matrix3, Rotation3, Unit, Vector3, Vector6};
 
 use crate::error::{Result, RobotError};
 use crate::model::{BodyPoint, Robot};
@@ -116,11 +116,18 @@ impl Robot {
         data.check(self)?;
         self.check_configuration(q)?;
         for (j, joint) in self.joints.iter().enumerate() {
-            let o_m_parent = data.o_m_body[j];
-            let o_m_joint = o_m_parent * joint.origin;
-            data.o_axis[j] = o_m_joint.rotation * joint.axis.into_inner();
+            // o_M_{j+1} = o_M_j · j_M_joint · Rot(axis, q_j): one isometry product and one
+            // rotation, the rotation done on columns when the axis is a coordinate axis (the
+            // URDF of a universal joint has x and y).
+            let o_m_joint = data.o_m_body[j] * joint.origin;
+            let axis = joint.axis.into_inner();
+            data.o_axis[j] = o_m_joint.rotation * axis;
             data.o_pivot[j] = o_m_joint.translation.vector;
-            data.o_m_body[j + 1] = o_m_parent * self.joint_transform(j, q[j]);
+            let rotation = rotate(o_m_joint.rotation.matrix(), &axis, q[j]);
+            data.o_m_body[j + 1] = IsometryMatrix3::from_parts(
+                o_m_joint.translation,
+                Rotation3::from_matrix_unchecked(rotation),
+            );
         }
         Ok(())
     }
@@ -393,4 +400,56 @@ impl Robot {
 pub(crate) fn world_point(data: &RobotData, point: &BodyPoint) -> Vector3<f64> {
     let pose = &data.o_m_body[point.body];
     pose.rotation * point.point + pose.translation.vector
+}
+
+/// `R · Rot(axis, q)` for a unit `axis`: column operations when `axis` is `±x`, `±y` or `±z`
+/// (exact zeros and ones of the elementary rotation need no arithmetic), Rodrigues' formula
+/// otherwise.
+#[inline]
+fn rotate(r: &Matrix3<f64>, axis: &Vector3<f64>, q: f64) -> Matrix3<f64> {
+    let (s, c) = q.sin_cos();
+    let (c0, c1, c2) = (r.column(0), r.column(1), r.column(2));
+    match (axis.x, axis.y, axis.z) {
+        (x, 0.0, 0.0) if x.abs() == 1.0 => {
+            let s = x * s;
+            Matrix3::from_columns(&[c0.into_owned(), c1 * c + c2 * s, c2 * c - c1 * s])
+        }
+        (0.0, y, 0.0) if y.abs() == 1.0 => {
+            let s = y * s;
+            Matrix3::from_columns(&[c0 * c - c2 * s, c1.into_owned(), c0 * s + c2 * c])
+        }
+        (0.0, 0.0, z) if z.abs() == 1.0 => {
+            let s = z * s;
+            Matrix3::from_columns(&[c0 * c + c1 * s, c1 * c - c0 * s, c2.into_owned()])
+        }
+        _ => r * Rotation3::from_axis_angle(&Unit::new_unchecked(*axis), q).matrix(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The column shortcut equals `R · Rot(axis, q)` by Rodrigues for every signed coordinate
+    /// axis, and the general branch is taken for any other axis.
+    #[test]
+    fn rotate_matches_rodrigues() {
+        let r = *Rotation3::from_euler_angles(0.3, -1.1, 2.0).matrix();
+        let mut axes: Vec<Vector3<f64>> = Vec::new();
+        for k in 0..3 {
+            let mut a = Vector3::zeros();
+            a[k] = 1.0;
+            axes.push(a);
+            axes.push(-a);
+        }
+        axes.push(Vector3::new(1.0, 2.0, -0.5).normalize());
+        for axis in &axes {
+            for q in [-2.5, -0.4, 0.0, 0.7, 3.0] {
+                let expected = r * Rotation3::from_axis_angle(&Unit::new_normalize(*axis), q).matrix();
+                let got = rotate(&r, axis, q);
+                let err = (got - expected).abs().max();
+                assert!(err <= 1e-15, "axis {axis:?}, q {q}: {err:e}");
+            }
+        }
+    }
 }

@@ -1,6 +1,6 @@
 //! The immutable robot description: a serial chain of revolute joints built once from a URDF.
 
-use nalgebra::{IsometryMatrix3, Matrix3, Point3, Rotation3, Translation3, Unit, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Point3, Unit, Vector3};
 
 use crate::error::{Result, RobotError};
 
@@ -213,13 +213,5 @@ impl Robot {
             return Err(RobotError::NoSuchBody { body, bodies: self.bodies.len() });
         }
         Ok(())
-    }
-
-    /// The pose of joint `j`'s frame in its parent body frame at angle `q`:
-    /// `parent_M_joint · Rot(axis, q)`.
-    pub(crate) fn joint_transform(&self, j: usize, q: f64) -> IsometryMatrix3<f64> {
-        let joint = &self.joints[j];
-        let rotation = Rotation3::from_axis_angle(&joint.axis, q);
-        joint.origin * IsometryMatrix3::from_parts(Translation3::identity(), rotation)
     }
 }

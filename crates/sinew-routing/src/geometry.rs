@@ -141,14 +141,26 @@ impl RoutingData {
             got: s,
         })?;
         let n = seg.dofs.len();
-        let block = self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n).ok_or(
-            RoutingError::WorkspaceMismatch {
-                what: "routing workspace (Hessian storage)",
-                expected: routing.hessian_len,
-                got: self.hessians.len(),
-            },
-        )?;
+        let block = self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n);
+        let block = block.ok_or(RoutingError::WorkspaceMismatch {
+            what: "routing workspace (Hessian storage)",
+            expected: routing.hessian_len,
+            got: self.hessians.len(),
+        })?;
         Ok(MatRef::from_column_major_slice(block, n, n))
+    }
+
+    /// Every segment's Hessian block, with the workspace checked against `routing` once: for
+    /// loops over many segments (the joint stiffness visits each segment once per
+    /// configuration), where [`RoutingData::segment_hessian`] would repeat the checks.
+    ///
+    /// # Errors
+    /// [`RoutingError::NotComputed`] unless evaluated with [`Order::Hessians`];
+    /// [`RoutingError::WorkspaceMismatch`] for a workspace of another routing.
+    pub fn segment_hessians<'a>(&'a self, routing: &'a Routing) -> Result<SegmentHessians<'a>> {
+        self.check(routing)?;
+        self.need(Order::Hessians, "cable Hessians")?;
+        Ok(SegmentHessians { routing, hessians: &self.hessians })
     }
 
     /// Write cable `c`'s Hessian `H_c = ∂²L_c/∂Q²` (dof × dof, m/rad², symmetric) into `out`.
@@ -233,6 +245,26 @@ impl RoutingData {
             }
         }
         Ok(())
+    }
+}
+
+/// The Hessian blocks of every segment at the last evaluated configuration, from
+/// [`RoutingData::segment_hessians`].
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentHessians<'a> {
+    routing: &'a Routing,
+    hessians: &'a [f64],
+}
+
+impl<'a> SegmentHessians<'a> {
+    /// Segment `s`'s Hessian block `∂²L_s/∂q_i∂q_k` over its joints `segments()[s].dofs`
+    /// (square, m/rad², column-major); `None` when `s` is out of range.
+    #[inline]
+    pub fn get(&self, s: usize) -> Option<MatRef<'a, f64>> {
+        let seg = self.routing.segments.get(s)?;
+        let n = seg.dofs.len();
+        let block = self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n)?;
+        Some(MatRef::from_column_major_slice(block, n, n))
     }
 }
 

@@ -50,7 +50,8 @@ pub mod spec;
 
 pub use error::{Result, RoutingError};
 pub use geometry::{
-    Order, RoutingData, compute_cable_geometry, compute_cable_geometry_from_kinematics,
+    Order, RoutingData, SegmentHessians, compute_cable_geometry,
+    compute_cable_geometry_from_kinematics,
 };
 pub use routing::{
     Cable, Hole, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment, load,

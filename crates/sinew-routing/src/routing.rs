@@ -431,7 +431,7 @@ pub(crate) fn check_shape(
 }
 
 fn world(rdata: &RobotData, p: &BodyPoint) -> Result<Vector3<f64>> {
-    let pose = rdata.body_pose(p.body).ok_or(RoutingError::WorkspaceMismatch {
+    let pose = rdata.body_pose(p.body).ok_or_else(|| RoutingError::WorkspaceMismatch {
         what: "robot workspace (bodies)",
         expected: p.body + 1,
         got: p.body,

@@ -143,13 +143,14 @@ impl ArmStatics {
                 delta_tau[1] += jacobian[(c, 2 * k + 1)] * out[c];
             }
             let block = Matrix3x2::from_fn(|r, col| jacobian[(3 * k + r, 2 * k + col)]);
-            let delta =
-                minimum_norm_tensions(&block, &delta_tau).ok_or(StaticsError::Infeasible {
+            let delta = minimum_norm_tensions(&block, &delta_tau).ok_or_else(|| {
+                StaticsError::Infeasible {
                     joint: k,
                     torque: [data.t0[2 * k], data.t0[2 * k + 1]],
                     limits: [self.limits.f_min, self.limits.f_max],
                     reason: InfeasibleReason::RankDeficient,
-                })?;
+                }
+            })?;
             out[3 * k..3 * k + 3].copy_from_slice(delta.as_slice());
         }
         Ok(())

@@ -201,12 +201,9 @@ impl ArmStiffness {
         }
         data.solver = EndSolver::Dense;
         data.k_w_filled();
-        let k_w =
-            data.k_w.get().map(ColMajor::as_ref).ok_or(StiffnessError::DimensionMismatch {
-                what: "K_W",
-                expected: data.k_q.rows(),
-                got: 0,
-            })?;
+        let k_w = data.k_w.get().map(ColMajor::as_ref).ok_or_else(|| {
+            StiffnessError::DimensionMismatch { what: "K_W", expected: data.k_q.rows(), got: 0 }
+        })?;
         end_compliance(data.k_q.as_ref(), k_w, data.j_x.as_ref(), &mut data.end)
     }
 

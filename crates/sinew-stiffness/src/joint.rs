@@ -21,7 +21,7 @@ use std::ops::Range;
 
 use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
-use sinew_routing::{Routing, RoutingData};
+use sinew_routing::{Routing, RoutingData, SegmentHessians};
 
 use crate::error::StiffnessError;
 use crate::structured::{BlockLayout, ColMajor, MAX_BLOCK, zero_blocks};
@@ -109,9 +109,10 @@ pub(crate) fn joint_stiffness_in_blocks(
         return Ok(());
     }
     let j_c = geometry.jacobian()?;
+    let hessians = geometry.segment_hessians(routing)?;
     for (k, block) in layout.blocks().enumerate() {
         let cables = layout.cables_of(k);
-        let args = (routing, geometry, j_c, tensions, cables, block.start);
+        let args = (routing, hessians, j_c, tensions, cables, block.start);
         let parts = &mut (&mut *controllable, &mut *inherent, &mut *k_q);
         match block.len() {
             1 => block_stiffness::<1>(args, parts)?,
@@ -134,9 +135,9 @@ pub(crate) fn joint_stiffness_in_blocks(
 /// segment) and `k_c J_cᵀ J_c` (each product once, both triangles), then the three matrices.
 #[inline(always)]
 fn block_stiffness<const B: usize>(
-    (routing, geometry, j_c, tensions, cables, lo): (
+    (routing, hessians, j_c, tensions, cables, lo): (
         &Routing,
-        &RoutingData,
+        SegmentHessians<'_>,
         MatRef<'_, f64>,
         &[f64],
         &[usize],
@@ -156,7 +157,7 @@ fn block_stiffness<const B: usize>(
             if span == 0 || o + span > B {
                 continue;
             }
-            let h = geometry.segment_hessian(routing, s)?;
+            let Some(h) = hessians.get(s) else { continue };
             if span == B {
                 // The common case (a segment across the whole block): fixed bounds.
                 for kk in 0..B {
