@@ -1,9 +1,9 @@
 //! `sinew arm`: the whole arm in a pose under a load (eq. 5–21).
 
-use nalgebra::{Matrix3, Vector6};
+use nalgebra::Vector6;
 use serde::Serialize;
 use sinew::indicators::StiffnessEllipsoid;
-use sinew::stiffness::{ArmStiffness, RANK_TOLERANCE, StiffnessError, stability_margin};
+use sinew::stiffness::{ArmStiffness, StiffnessError, stability_margin};
 
 use crate::cli::ArmArgs;
 use crate::error::{CliError, model_error};
@@ -131,12 +131,8 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     };
     let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(model_error)?;
     let c_x = stable.then(|| faer_rows(data.compliance()));
-    // (C_x[0:3, 0:3])⁻¹ only where that block has full rank (same tolerance as K_x's).
-    let translational_block = Matrix3::from_fn(|i, j| data.compliance()[(i, j)]);
-    let sv = translational_block.singular_values();
-    let block_full_rank = sv.min() > RANK_TOLERANCE * sv.max();
-    let k_translational =
-        if stable && block_full_rank { data.translational_stiffness() } else { None };
+    // (C_x[0:3, 0:3])⁻¹: None where that block is singular (same tolerance as K_x's).
+    let k_translational = if stable { data.translational_stiffness() } else { None };
     if stable && k_translational.is_none() {
         notes.push(
             "C_x[0:3, 0:3] is singular (the end cannot translate in some direction): \

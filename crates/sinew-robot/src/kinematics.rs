@@ -445,7 +445,8 @@ mod tests {
         axes.push(Vector3::new(1.0, 2.0, -0.5).normalize());
         for axis in &axes {
             for q in [-2.5, -0.4, 0.0, 0.7, 3.0] {
-                let expected = r * Rotation3::from_axis_angle(&Unit::new_normalize(*axis), q).matrix();
+                let expected =
+                    r * Rotation3::from_axis_angle(&Unit::new_normalize(*axis), q).matrix();
                 let got = rotate(&r, axis, q);
                 let err = (got - expected).abs().max();
                 assert!(err <= 1e-15, "axis {axis:?}, q {q}: {err:e}");

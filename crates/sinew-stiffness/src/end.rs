@@ -90,9 +90,14 @@ impl EndStiffnessData {
     }
 
     /// `(C_x[0:3, 0:3])⁻¹` (N/m): the force per unit displacement when the end-effector is
-    /// free to rotate (a pure force applied). `None` when that block is singular.
+    /// free to rotate (a pure force applied). `None` when that block is singular: its smallest
+    /// singular value at most [`RANK_TOLERANCE`] of its largest (the end cannot translate in
+    /// some direction, and a plain inverse would return numbers of 1e17), or not finite.
     pub fn translational_stiffness(&self) -> Option<Matrix3<f64>> {
-        Matrix3::from_fn(|i, j| self.c_x[i + 6 * j]).try_inverse()
+        let block = Matrix3::from_fn(|i, j| self.c_x[i + 6 * j]);
+        let sv = block.singular_values();
+        // Written so that NaN also counts as singular.
+        if sv.min() > RANK_TOLERANCE * sv.max() { block.try_inverse() } else { None }
     }
 
     /// Store a compliance computed elsewhere (the structured solve), row-major.

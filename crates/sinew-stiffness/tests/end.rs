@@ -114,6 +114,32 @@ fn a_rank_deficient_jacobian_is_reported_and_keeps_the_compliance() {
 }
 
 #[test]
+fn a_singular_translational_block_has_no_translational_stiffness() {
+    let mut rng = ChaCha8Rng::seed_from_u64(44);
+    let n = 10;
+    let k_q = spd(&mut rng, n);
+    let k_w = Mat::zeros(n, n);
+    let mut data = EndStiffnessData::new(n);
+    // Joint motions move the end along z only by `scale`: C_x[0:3, 0:3] has a singular value
+    // of order scale².
+    for (scale, expect_some) in [(1e-3, true), (1e-8, false), (0.0, false)] {
+        let mut j_x = random(&mut rng, 6, n);
+        for c in 0..n {
+            j_x[(2, c)] *= scale;
+        }
+        end_compliance(k_q.as_ref(), k_w.as_ref(), j_x.as_ref(), &mut data).unwrap();
+        let k_t = data.translational_stiffness();
+        assert_eq!(k_t.is_some(), expect_some, "scale {scale}: {k_t:?}");
+        if let Some(k_t) = k_t {
+            // A real inverse of the block.
+            let block = nalgebra::Matrix3::from_fn(|i, j| data.compliance()[(i, j)]);
+            let err = (k_t * block - nalgebra::Matrix3::identity()).abs().max();
+            assert!(err < 1e-8, "scale {scale}: |K_t C - I| = {err:e}");
+        }
+    }
+}
+
+#[test]
 fn wrong_sizes_are_errors() {
     let n = 10;
     let mut data = EndStiffnessData::new(n);
