@@ -135,19 +135,11 @@ impl RoutingData {
     pub fn segment_hessian<'a>(&'a self, routing: &Routing, s: usize) -> Result<MatRef<'a, f64>> {
         self.check(routing)?;
         self.need(Order::Hessians, "cable Hessians")?;
-        let seg = routing.segments.get(s).ok_or(RoutingError::DimensionMismatch {
+        hessian_block(routing, &self.hessians, s).ok_or(RoutingError::DimensionMismatch {
             what: "segment index",
             expected: routing.segments.len(),
             got: s,
-        })?;
-        let n = seg.dofs.len();
-        let block = self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n);
-        let block = block.ok_or(RoutingError::WorkspaceMismatch {
-            what: "routing workspace (Hessian storage)",
-            expected: routing.hessian_len,
-            got: self.hessians.len(),
-        })?;
-        Ok(MatRef::from_column_major_slice(block, n, n))
+        })
     }
 
     /// Every segment's Hessian block, with the workspace checked against `routing` once: for
@@ -261,11 +253,17 @@ impl<'a> SegmentHessians<'a> {
     /// (square, m/rad², column-major); `None` when `s` is out of range.
     #[inline]
     pub fn get(&self, s: usize) -> Option<MatRef<'a, f64>> {
-        let seg = self.routing.segments.get(s)?;
-        let n = seg.dofs.len();
-        let block = self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n)?;
-        Some(MatRef::from_column_major_slice(block, n, n))
+        hessian_block(self.routing, self.hessians, s)
     }
+}
+
+/// Segment `s`'s block in the Hessian storage of a workspace sized for `routing`.
+#[inline]
+fn hessian_block<'a>(routing: &Routing, hessians: &'a [f64], s: usize) -> Option<MatRef<'a, f64>> {
+    let seg = routing.segments.get(s)?;
+    let n = seg.dofs.len();
+    let block = hessians.get(seg.hessian_offset..seg.hessian_offset + n * n)?;
+    Some(MatRef::from_column_major_slice(block, n, n))
 }
 
 /// Forward kinematics at `q`, then [`compute_cable_geometry_from_kinematics`]: the cable
