@@ -580,13 +580,42 @@ fn add_gram<const B: usize, const N: usize>(
 ) {
     let mut dv = *v;
     scale(l, &mut dv);
+    add_at_b_upper(s, &dv, v);
+}
+
+/// `acc += Aᵀ B` for `A` (`K × M`) and `B` (`K × N`), row-major arrays: the rank-`K` updates
+/// of the sweeps.
+#[inline(always)]
+fn add_at_b<const K: usize, const M: usize, const N: usize>(
+    acc: &mut [[f64; N]; M],
+    a: &[[f64; M]; K],
+    b: &[[f64; N]; K],
+) {
+    for (p, acc_row) in acc.iter_mut().enumerate() {
+        for (q, acc_pq) in acc_row.iter_mut().enumerate() {
+            let mut sum = 0.0;
+            for r in 0..K {
+                sum += a[r][p] * b[r][q];
+            }
+            *acc_pq += sum;
+        }
+    }
+}
+
+/// [`add_at_b`] on and above the diagonal only (`M = N`), for updates known to be symmetric.
+#[inline(always)]
+fn add_at_b_upper<const K: usize, const N: usize>(
+    acc: &mut [[f64; N]; N],
+    a: &[[f64; N]; K],
+    b: &[[f64; N]; K],
+) {
     for p in 0..N {
         for q in p..N {
             let mut sum = 0.0;
-            for r in 0..B {
-                sum += dv[r][p] * v[r][q];
+            for r in 0..K {
+                sum += a[r][p] * b[r][q];
             }
-            s[p][q] += sum;
+            acc[p][q] += sum;
         }
     }
 }
@@ -822,31 +851,11 @@ fn step_symmetric<const B: usize>(
     scale(&l, &mut dg);
     let mut de = e;
     scale(&l, &mut de);
-    for p in 0..6 {
-        for q in p..6 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += dg[r][p] * g[r][q];
-            }
-            st.c_x[p][q] += sum;
-        }
-    }
-    for comp in 0..3 {
-        for col in 0..6 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += de[r][comp] * g[r][col];
-            }
-            st.z[comp][col] += sum;
-        }
-    }
+    add_at_b_upper(&mut st.c_x, &dg, &g);
+    add_at_b(&mut st.z, &de, &g);
+    add_at_b_upper(&mut st.p, &de, &e);
     for p in 0..3 {
-        for q in p..3 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += de[r][p] * e[r][q];
-            }
-            st.p[p][q] += sum;
+        for q in p + 1..3 {
             st.p[q][p] = st.p[p][q];
         }
     }
@@ -933,42 +942,10 @@ fn step_general<const B: usize>(
     lu_solve(&m, &perm, &mut h);
     let mut f = w_t;
     lu_solve(&m, &perm, &mut f);
-    for p in 0..6 {
-        for q in 0..6 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += j_hat[r][p] * h[r][q];
-            }
-            st.c_x[p][q] += sum;
-        }
-    }
-    for comp in 0..3 {
-        for col in 0..6 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += u_t[r][comp] * h[r][col];
-            }
-            st.z[comp][col] += sum;
-        }
-    }
-    for col in 0..6 {
-        for comp in 0..3 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += j_hat[r][col] * f[r][comp];
-            }
-            st.z_left[col][comp] += sum;
-        }
-    }
-    for i in 0..3 {
-        for k in 0..3 {
-            let mut sum = 0.0;
-            for r in 0..B {
-                sum += u_t[r][i] * f[r][k];
-            }
-            st.p[i][k] += sum;
-        }
-    }
+    add_at_b(&mut st.c_x, &j_hat, &h);
+    add_at_b(&mut st.z, &u_t, &h);
+    add_at_b(&mut st.z_left, &j_hat, &f);
+    add_at_b(&mut st.p, &u_t, &f);
     factor.save(&m, &perm, &w_t, &rhs);
     true
 }
