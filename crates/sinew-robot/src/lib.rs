@@ -22,6 +22,7 @@
 #![deny(missing_docs)]
 
 mod description;
+mod display;
 mod error;
 mod generate;
 mod gravity;
@@ -30,6 +31,7 @@ mod model;
 mod urdf;
 
 pub use description::{DESCRIPTION_FILE, RobotDescription, load, load_urdf};
+pub use display::Compact;
 pub use error::{Result, RobotError};
 pub use generate::UniformChain;
 pub use kinematics::RobotData;
