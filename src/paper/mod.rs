@@ -1,11 +1,18 @@
 //! The paper's experiments (spec §6) as data, checks and fixed-precision tables: what
 //! `cargo xtask reproduce` writes and what the snapshot tests compare.
 //!
+//! [`Report::compute`] runs every experiment once, with every parameter a named constant
+//! (here and in `report.rs`); `cargo xtask reproduce` writes [`Report::text_files`] and draws
+//! the figures from the same [`Report`], `cargo xtask calibrate` and the tests use [`table_2`]
+//! and the one check of Table II's patterns, [`table_2_patterns`].
+//!
 //! Every number is printed at a fixed precision with `-0` normalised to `0` ([`fixed`]), so a
 //! rendered table changes only when a number really changes.
 
 mod arm;
 mod claims;
+mod patterns;
+mod report;
 mod single_joint;
 mod table1;
 
@@ -14,6 +21,14 @@ pub use arm::{
     render_routed_vs_decoupled,
 };
 pub use claims::{Claim, claims_e1_e3, render_claims};
+pub use patterns::{
+    LEAST_RANGE_AWAY, MAX_RISE, MAX_RISE_OVER_MIN_MOVE, NEAR_ZERO_MAX, NEAR_ZERO_SHARE,
+    WIDER_Q2_NEGATIVE, WIDER_Q2_POSITIVE, table_2_patterns,
+};
+pub use report::{
+    E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE, FIG4_FILE, FIG5_MAPS, FIG6_FILE,
+    HeatMap, REPORT_DIR, ROBOT_DIR, ROUTED_FILE, Report,
+};
 pub use single_joint::{
     E2_Q, E2_TORQUE, E2Point, E3_TORQUE, PAPER_TABLE_2, TABLE_2_TORQUE, Table2Row, e2, e2_csv, e3,
     e3_csv, render_table_2, rms_relative_error, table_2,

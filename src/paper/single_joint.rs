@@ -49,6 +49,15 @@ impl Table2Row {
     pub fn paper_delta(&self) -> [f64; 2] {
         [self.paper[0][1] - self.paper[0][0], self.paper[1][1] - self.paper[1][0]]
     }
+
+    /// The relative errors `(ours − paper) / paper` of the four interval ends:
+    /// `[K_x min, K_x max, K_y min, K_y max]`.
+    pub fn relative_errors(&self) -> [f64; 4] {
+        let e = |axis: usize, end: usize| {
+            (self.ours[axis][end] - self.paper[axis][end]) / self.paper[axis][end]
+        };
+        [e(0, 0), e(0, 1), e(1, 0), e(1, 1)]
+    }
 }
 
 /// Table II (E1) on joint 1 (index 0) of `robot` with `routing`.
@@ -72,18 +81,12 @@ pub fn table_2(robot: &Robot, routing: &Routing) -> Result<Vec<Table2Row>, Indic
 
 /// RMS relative error of ours against the paper over the 20 interval ends.
 pub fn rms_relative_error(rows: &[Table2Row]) -> f64 {
-    let mut sum = 0.0;
-    let mut count = 0;
-    for row in rows {
-        for axis in 0..2 {
-            for end in 0..2 {
-                let e = (row.ours[axis][end] - row.paper[axis][end]) / row.paper[axis][end];
-                sum += e * e;
-                count += 1;
-            }
-        }
+    let errors: Vec<f64> = rows.iter().flat_map(Table2Row::relative_errors).collect();
+    if errors.is_empty() {
+        0.0
+    } else {
+        (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt()
     }
-    if count == 0 { 0.0 } else { (sum / count as f64).sqrt() }
 }
 
 fn q_label(q: [f64; 2]) -> String {
