@@ -3,7 +3,8 @@
 //!
 //! # The model
 //! One universal joint of the platform (eq. 1) with its three cables in the paper's decoupled
-//! model, computed by the library ([`sinew::indicators::JointProbe`], the paper's single-joint model): at the five angles of
+//! model, computed by the library as the report computes it ([`sinew::paper::table_2`], through
+//! [`sinew::indicators::JointProbe`], the paper's single-joint model): at the five angles of
 //! Table II, holding `τ = [0.3, 0.3]` N m with tensions in `[20, 600]` N, the range of `K_x` and
 //! of `K_y` over the feasible tensions. The residuals are the 20 relative errors
 //! `(ours − paper) / paper`; a parameter set for which a configuration's torque cannot be held
