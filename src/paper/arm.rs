@@ -13,7 +13,8 @@ use crate::routing::Routing;
 use crate::stiffness::{ArmStiffness, StiffnessError, stability_margin};
 
 use super::claims::Claim;
-use super::{E4_F0, E4_Q, fixed};
+use super::experiments::{E4_CASES, E4_F0, E4_Q};
+use super::fixed;
 
 /// One joint of E4: its tension interval and the range of its stiffness.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,16 +68,6 @@ impl E4 {
         }
     }
 }
-
-/// The four cases of Fig. 6: (a) every joint at the baseline level (the lowest in the paper),
-/// (b) joint 3 raised to its highest, (c) joint 5 raised, (d) joints 3 and 5 raised (joints
-/// numbered from 1 at the base). `true` marks a raised joint.
-pub const E4_CASES: [(&str, [bool; 5]); 4] = [
-    ("(a) every joint at the baseline level", [false; 5]),
-    ("(b) joint 3 at its highest level", [false, false, true, false, false]),
-    ("(c) joint 5 at its highest level", [false, false, false, false, true]),
-    ("(d) joints 3 and 5 at their highest levels", [false, false, true, false, true]),
-];
 
 /// Run E4 on a five-joint robot with a routing; the joints a case does not raise sit at
 /// tension level `baseline` (0 in the paper).

@@ -12,6 +12,7 @@ use crate::routing::Routing;
 
 use super::arm::{E4, claims_e4_end, claims_e4_joints, e4, render_e4, render_routed_vs_decoupled};
 use super::claims::{Claim, claims_e1_e3, render_claims};
+use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE};
 use super::single_joint::{E2Point, Table2Row, e2, e2_csv, e3, e3_csv, render_table_2, table_2};
 use super::table1::table_1;
 
@@ -21,15 +22,6 @@ pub const ROBOT_DIR: &str = "robots/cdhrm5";
 pub const ROUTED_FILE: &str = "cables-routed.toml";
 /// Where the report is committed, relative to the workspace root.
 pub const REPORT_DIR: &str = "docs/reproduction";
-/// Points along E2's feasible tension segment (Fig. 4).
-pub const E2_SAMPLES: usize = 41;
-/// Points per axis of E3's grid of joint angles (Fig. 5).
-pub const E3_POINTS: usize = 121;
-/// The paper's tension level of the joints an E4 case does not raise: their lowest.
-pub const E4_PAPER_BASELINE: f64 = 0.0;
-/// The tension level of the joints an E4 case does not raise in the extra decoupled run, where
-/// the decoupled arm is stable (from about 0.1).
-pub const E4_STABLE_BASELINE: f64 = 0.25;
 
 /// Fig. 4's file (line plots: SVG).
 pub const FIG4_FILE: &str = "fig4_e2.svg";
