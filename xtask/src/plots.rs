@@ -94,7 +94,8 @@ pub fn heat_map(
     let side = n * CELL;
     let (left, top) = (136, 64);
     let bar = left + side + 40;
-    let mut img = Canvas::new(bar + BAR_WIDTH + 110, top + side + 76);
+    let width = (bar + BAR_WIDTH + 110).max(title.chars().count() * GLYPH + 16);
+    let mut img = Canvas::new(width, top + side + 76);
 
     for a in 0..n {
         for b in 0..n {
@@ -123,10 +124,12 @@ pub fn heat_map(
         img.text(x.saturating_sub(img.width_of(&label) / 2), top + side + TICK + 4, &label);
         let y = top + side - to_pixel(q).max(1);
         img.fill(left - TICK, y, TICK, 1, BLACK_RGB);
-        img.text(left - TICK - 4 - img.width_of(&label), y.saturating_sub(GLYPH / 2), &label);
+        let x = (left - TICK - 4).saturating_sub(img.width_of(&label));
+        img.text(x, y.saturating_sub(GLYPH / 2), &label);
     }
     let x_title = "q1 (rad)";
-    img.text(left + (side - img.width_of(x_title)) / 2, top + side + TICK + GLYPH + 14, x_title);
+    let x = (left + side / 2).saturating_sub(img.width_of(x_title) / 2);
+    img.text(x, top + side + TICK + GLYPH + 14, x_title);
     let y_title = "q2 (rad)";
     img.text_upwards(left - 116, top + (side + img.width_of(y_title)) / 2, y_title);
     let (ticks, decimals) = nice_ticks(lo, hi, 6);
@@ -156,13 +159,18 @@ const INFEASIBLE: [u8; 3] = [200, 200, 200];
 const BLACK_RGB: [u8; 3] = [0, 0, 0];
 
 /// About `count` round tick values (1, 2 or 5 times a power of ten apart) in `[lo, hi]`, and
-/// the decimals their labels need.
+/// the decimals their labels need. The power of ten is an integer exponent, so that the
+/// decimals do not hang on the last bit of a logarithm.
 fn nice_ticks(lo: f64, hi: f64, count: usize) -> (Vec<f64>, usize) {
     let raw = (hi - lo) / count as f64;
-    let magnitude = 10f64.powf(raw.log10().floor());
-    let step =
-        [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * magnitude).find(|s| *s >= raw).unwrap_or(raw);
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    let mut exponent = raw.log10().floor() as i32;
+    let mut mantissa =
+        [1.0, 2.0, 5.0, 10.0].into_iter().find(|m| m * 10f64.powi(exponent) >= raw).unwrap_or(10.0);
+    if mantissa == 10.0 {
+        (mantissa, exponent) = (1.0, exponent + 1);
+    }
+    let step = mantissa * 10f64.powi(exponent);
+    let decimals = usize::try_from(-exponent).unwrap_or(0);
     let (first, last) = ((lo / step).ceil() as i64, (hi / step).floor() as i64);
     ((first..=last).map(|k| k as f64 * step).collect(), decimals)
 }
@@ -223,8 +231,9 @@ impl Canvas {
     fn text_upwards(&mut self, x: usize, bottom: usize, text: &str) {
         for (k, ch) in text.chars().enumerate() {
             for (col, row) in Self::dots(ch) {
-                let y = bottom - k * GLYPH - (col + 1) * SCALE;
-                self.fill(x + row * SCALE, y, SCALE, SCALE, BLACK_RGB);
+                if let Some(y) = bottom.checked_sub(k * GLYPH + (col + 1) * SCALE) {
+                    self.fill(x + row * SCALE, y, SCALE, SCALE, BLACK_RGB);
+                }
             }
         }
     }
@@ -379,4 +388,53 @@ fn svg_ellipse(m: &nalgebra::Matrix2<f64>, centre: (i32, i32), colour: RGBColor)
         fixed(angle.to_degrees(), 4),
         hex(colour)
     )
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn ticks_are_round_and_inside_the_range() {
+        let (ticks, decimals) = nice_ticks(-0.5454, 0.5454, 6);
+        let labels: Vec<String> = ticks.iter().map(|t| fixed(*t, decimals)).collect();
+        assert_eq!(labels, ["-0.4", "-0.2", "0.0", "0.2", "0.4"]);
+        let (ticks, decimals) = nice_ticks(1.93, 16.3, 6);
+        assert_eq!((ticks, decimals), (vec![5.0, 10.0, 15.0], 0));
+    }
+
+    #[test]
+    fn an_svg_ellipse_has_the_eigen_axes_of_its_matrix() {
+        let axis_aligned = svg_ellipse(&nalgebra::Matrix2::new(9.0, 0.0, 0.0, 4.0), (10, 20), RED);
+        assert_eq!(
+            axis_aligned,
+            "<ellipse cx=\"10\" cy=\"20\" rx=\"3.000\" ry=\"2.000\" transform=\"rotate(0.0000, 10, 20)\" fill=\"none\" stroke=\"#FF0000\" stroke-width=\"2\"/>\n"
+        );
+        // R diag(9, 4) Rᵀ with R a rotation by 30°.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let r = nalgebra::Matrix2::new(c, -s, s, c);
+        let m = r * nalgebra::Matrix2::new(9.0, 0.0, 0.0, 4.0) * r.transpose();
+        let rotated = svg_ellipse(&m, (0, 0), BLUE);
+        assert!(rotated.contains("rx=\"3.000\" ry=\"2.000\" transform=\"rotate(30.0000, 0, 0)\""));
+    }
+
+    #[test]
+    fn a_png_heat_map_is_the_same_bytes_twice() {
+        let maps = SweepMaps {
+            joint: 0,
+            torque: [0.0; 2],
+            grid: sinew::indicators::AngleGrid { lower: -0.5, upper: 0.5, points: 3 },
+            cells: vec![None; 9],
+        };
+        let dir = std::env::temp_dir().join(format!("sinew-heat-map-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+        heat_map(&maps, "t", |c| c.k_x.range[0], &a).unwrap();
+        heat_map(&maps, "t", |c| c.k_x.range[0], &b).unwrap();
+        let bytes = std::fs::read(&a).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+        assert_eq!(bytes, std::fs::read(&b).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
