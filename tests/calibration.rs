@@ -4,78 +4,73 @@
 //! the rendered table itself is a snapshot in reproduction.rs).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use sinew::paper::PAPER_TABLE_2 as PAPER;
+use sinew::paper::{PAPER_TABLE_2 as PAPER, Table2Row};
 
-fn ours() -> Vec<[[f64; 2]; 2]> {
+fn table() -> Vec<Table2Row> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
     let robot = sinew::robot::load(dir).unwrap();
     let routing = sinew::routing::load(dir, &robot).unwrap();
-    sinew::paper::table_2(&robot, &routing).unwrap().into_iter().map(|row| row.ours).collect()
-}
-
-fn delta(row: &[[f64; 2]; 2], axis: usize) -> f64 {
-    row[axis][1] - row[axis][0]
+    sinew::paper::table_2(&robot, &routing).unwrap()
 }
 
 #[test]
 fn cdhrm5_reproduces_table_ii_within_ten_percent_rms() {
-    let rows = ours();
-    let mut sum = 0.0;
+    let rows = table();
     for (row, (q, kx, ky)) in rows.iter().zip(PAPER.iter()) {
         println!(
             "q = {q:.3?}: K_x {:.2?} (paper {kx:?}), K_y {:.2?} (paper {ky:?})",
-            row[0], row[1]
+            row.ours[0], row.ours[1]
         );
-        for (axis, paper) in [kx, ky].into_iter().enumerate() {
-            assert!(row[axis][0] <= row[axis][1]);
-            for end in 0..2 {
-                let e = (row[axis][end] - paper[end]) / paper[end];
-                // No single entry is far off either (the fit's worst is about 21 %).
-                assert!(e.abs() < 0.25, "q = {q:?}, axis {axis}, end {end}: error {e:.3}");
-                sum += e * e;
-            }
+        assert_eq!((row.q, row.paper), (*q, [*kx, *ky]));
+        for axis in 0..2 {
+            assert!(row.ours[axis][0] <= row.ours[axis][1]);
+        }
+        for (k, e) in row.relative_errors().into_iter().enumerate() {
+            // No single entry is far off either (the fit's worst is about 21 %).
+            assert!(e.abs() < 0.25, "q = {q:?}, axis {}, end {}: error {e:.3}", k / 2, k % 2);
         }
     }
-    let rms = (sum / 20.0).sqrt();
+    assert_eq!(rows.len(), 5);
+    let rms = sinew::paper::rms_relative_error(&rows);
     println!("RMS relative error: {:.2} %", 100.0 * rms);
     assert!(rms <= 0.10, "RMS relative error {rms:.4}");
     // And it is the calibrated geometry, not a lucky one: about 9 %.
     assert!(rms > 0.05, "RMS relative error {rms:.4}: recalibrated? update this test");
 }
 
+/// The patterns, with the one set of thresholds the report and `cargo xtask calibrate` use
+/// (`sinew::paper::table_2_patterns`).
 #[test]
 fn cdhrm5_reproduces_the_patterns_of_table_ii() {
-    let rows = ours();
-    // Near-zero range at q = 0: the paper's is 0.06 / 0.05 against ≥ 4.98 elsewhere.
-    let least_other =
-        rows[1..].iter().flat_map(|r| [delta(r, 0), delta(r, 1)]).fold(f64::INFINITY, f64::min);
-    assert!(least_other > 4.0, "least range away from q = 0: {least_other}");
+    let rows = table();
+    let patterns = sinew::paper::table_2_patterns(&rows);
+    assert_eq!(patterns.len(), 4);
+    for p in &patterns {
+        assert!(p.checkable && p.holds, "{}: {}", p.claim, p.evidence);
+    }
+    // And K at q = 0 is Table II's ~1.9 N m/rad.
     for axis in 0..2 {
-        let d = delta(&rows[0], axis);
-        assert!(d <= 0.05 * least_other && d < 0.1, "range at q = 0, axis {axis}: {d}");
-        // And K at q = 0 is Table II's ~1.9 N m/rad.
-        assert!((1.85..=1.98).contains(&rows[0][axis][0]), "{:?}", rows[0]);
+        assert!((1.85..=1.98).contains(&rows[0].ours[axis][0]), "{:?}", rows[0]);
     }
-    // q2 < 0 (rows 2, 4): K_x has the wider range, by far (paper: 15.64 against 6.74).
-    for i in [2, 4] {
-        let (dx, dy) = (delta(&rows[i], 0), delta(&rows[i], 1));
-        assert!(dx > 2.0 * dy, "q = {:?}: Δk_x {dx}, Δk_y {dy}", PAPER[i].0);
+}
+
+/// The pattern check itself: it holds for the paper's own numbers, and fails when a pattern
+/// is broken.
+#[test]
+fn the_pattern_check_holds_for_the_paper_and_fails_without_its_patterns() {
+    let paper: Vec<Table2Row> =
+        PAPER.iter().map(|&(q, kx, ky)| Table2Row { q, ours: [kx, ky], paper: [kx, ky] }).collect();
+    for p in sinew::paper::table_2_patterns(&paper) {
+        assert!(p.checkable && p.holds, "{}: {}", p.claim, p.evidence);
     }
-    // q2 > 0 (rows 1, 3): K_y has the wider range (paper: 8.08 / 8.40 against 4.98 / 5.18).
-    for i in [1, 3] {
-        let (dx, dy) = (delta(&rows[i], 0), delta(&rows[i], 1));
-        assert!(dy > 1.5 * dx, "q = {:?}: Δk_x {dx}, Δk_y {dy}", PAPER[i].0);
-    }
-    // Larger |q| raises mainly the maximum: it rises by more than the minimum moves.
-    for (i, row) in rows.iter().enumerate().skip(1) {
-        for axis in 0..2 {
-            let up = row[axis][1] - rows[0][axis][1];
-            let moved = (row[axis][0] - rows[0][axis][0]).abs();
-            assert!(
-                up > 3.0 * moved && up > 3.0,
-                "q = {:?}, axis {axis}: {up} vs {moved}",
-                PAPER[i].0
-            );
-        }
-    }
+    // Swap the axes: every pattern but the first two then fails.
+    let swapped: Vec<Table2Row> =
+        paper.iter().map(|r| Table2Row { ours: [r.ours[1], r.ours[0]], ..*r }).collect();
+    let verdicts: Vec<bool> =
+        sinew::paper::table_2_patterns(&swapped).iter().map(|p| p.holds).collect();
+    assert_eq!(verdicts, [true, false, false, true]);
+    // A wide range at q = 0 breaks the first.
+    let mut wide = paper.clone();
+    wide[0].ours[0][1] += 1.0;
+    assert!(!sinew::paper::table_2_patterns(&wide)[0].holds);
 }

@@ -13,7 +13,8 @@ use crate::routing::Routing;
 use crate::stiffness::{ArmStiffness, StiffnessError, stability_margin};
 
 use super::claims::Claim;
-use super::{E4_F0, E4_Q, fixed};
+use super::experiments::{E4_CASES, E4_F0, E4_Q};
+use super::fixed;
 
 /// One joint of E4: its tension interval and the range of its stiffness.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,15 +57,17 @@ pub struct E4 {
     pub cases: Vec<E4Case>,
 }
 
-/// The four cases of Fig. 6: (a) every joint at the baseline level (the lowest in the paper),
-/// (b) joint 3 raised to its highest, (c) joint 5 raised, (d) joints 3 and 5 raised (joints
-/// numbered from 1 at the base). `true` marks a raised joint.
-pub const E4_CASES: [(&str, [bool; 5]); 4] = [
-    ("(a) every joint at the baseline level", [false; 5]),
-    ("(b) joint 3 at its highest level", [false, false, true, false, false]),
-    ("(c) joint 5 at its highest level", [false, false, false, false, true]),
-    ("(d) joints 3 and 5 at their highest levels", [false, false, true, false, true]),
-];
+impl E4 {
+    /// The run's name in claims and figures: the routing model, and the baseline level when it
+    /// is not the paper's 0 (e.g. `decoupled with stable baseline 0.25`).
+    pub fn name(&self) -> String {
+        if self.baseline == 0.0 {
+            self.model.clone()
+        } else {
+            format!("{} with stable baseline {}", self.model, fixed(self.baseline, 2))
+        }
+    }
+}
 
 /// Run E4 on a five-joint robot with a routing; the joints a case does not raise sit at
 /// tension level `baseline` (0 in the paper).
@@ -249,9 +252,12 @@ pub fn claims_e4_joints(e4: &E4) -> Vec<Claim> {
     let unavailable = |claim: &str, why: &str| Claim::unchecked(claim, why);
 
     // (1) more tension, more joint stiffness.
-    let c1 = "Conclusion (1): more cable tension, more joint stiffness (E4, every joint)";
+    let c1 = format!(
+        "Conclusion (1), {}: more cable tension, more joint stiffness (E4, every joint)",
+        e4.name()
+    );
     if e4.joints.is_empty() {
-        claims.push(unavailable(c1, "the lowest tension levels are infeasible"));
+        claims.push(unavailable(&c1, "the lowest tension levels are infeasible"));
     } else {
         let rises = e4.joints.iter().all(|j| j.k_x[1] > j.k_x[0] && j.k_y[1] > j.k_y[0]);
         let evidence: Vec<String> = e4
@@ -274,9 +280,12 @@ pub fn claims_e4_joints(e4: &E4) -> Vec<Claim> {
         ));
     }
     // (2) larger joint angles widen the range: in E4, joint 3 (largest angles) has the widest range.
-    let c2 = "Conclusion (2): the joint with the largest angles (joint 3) has the widest adjustable range";
+    let c2 = format!(
+        "Conclusion (2), {}: the joint with the largest angles (joint 3) has the widest adjustable range",
+        e4.name()
+    );
     if e4.joints.is_empty() {
-        claims.push(unavailable(c2, "the lowest tension levels are infeasible"));
+        claims.push(unavailable(&c2, "the lowest tension levels are infeasible"));
     } else {
         let width: Vec<f64> =
             e4.joints.iter().map(|j| (j.k_x[1] - j.k_x[0]) + (j.k_y[1] - j.k_y[0])).collect();
@@ -303,7 +312,11 @@ pub fn claims_e4_joints(e4: &E4) -> Vec<Claim> {
 pub fn claims_e4_end(e4: &E4) -> Vec<Claim> {
     let mut claims = Vec::new();
     let unavailable = |claim: &str, why: &str| Claim::unchecked(claim, why);
-    let c3 = "Conclusion (3): raising joint 3 changes K_fd most, but not in every direction; joint 5 helps mainly in one direction; joints 3 and 5 together complement each other";
+    let c3 = format!(
+        "Conclusion (3), {}: raising joint 3 changes K_fd most, but not in every direction; joint 5 helps mainly in one direction; joints 3 and 5 together complement each other",
+        e4.name()
+    );
+    let c3 = c3.as_str();
     match (ellipsoid(e4, 0), ellipsoid(e4, 1), ellipsoid(e4, 2), ellipsoid(e4, 3)) {
         (Some(a), Some(b), Some(c), Some(d)) => {
             let change = |x: &StiffnessEllipsoid| (x.k_fd - a.k_fd).norm();

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use crate::indicators::SweepMaps;
 
 use super::fixed;
+use super::patterns::table_2_patterns;
 use super::single_joint::{E2Point, Table2Row};
 
 /// A claim of the paper, whether it holds in our model, and the numbers behind the verdict.
@@ -55,55 +56,10 @@ pub fn render_claims(claims: &[Claim]) -> String {
     s
 }
 
-/// Check the claims of E1 (Table II), E2 (Fig. 4) and E3 (Fig. 5).
+/// Check the claims of E1 (Table II, through [`table_2_patterns`]), E2 (Fig. 4) and E3 (Fig. 5).
 pub fn claims_e1_e3(table: &[Table2Row], e2: &[E2Point], e3: &SweepMaps) -> Vec<Claim> {
-    let mut claims = Vec::new();
-
-    // E1: the range at q = 0 is near zero.
-    if let Some(zero) = table.iter().find(|r| r.q == [0.0, 0.0]) {
-        let d = zero.ours_delta();
-        let others = table
-            .iter()
-            .filter(|r| r.q != [0.0, 0.0])
-            .flat_map(|r| r.ours_delta())
-            .fold(f64::INFINITY, f64::min);
-        claims.push(Claim::checked(
-            "E1: at q = [0, 0] the stiffness range is near zero (paper: Δk_x = 0.06, Δk_y = 0.05 N m/rad)",
-            d[0] < 0.1 * others && d[1] < 0.1 * others,
-            format!(
-                "ours: Δk_x = {}, Δk_y = {} N m/rad; the smallest range at the other four angles is {} N m/rad",
-                fixed(d[0], 3),
-                fixed(d[1], 3),
-                fixed(others, 3)
-            ),
-        ));
-    }
-    // E1: q2 < 0 → K_x wider; q2 > 0 → K_y wider.
-    for (sign, axis_name, wider) in [(-1.0, "K_x", 0usize), (1.0, "K_y", 1usize)] {
-        let rows: Vec<&Table2Row> = table.iter().filter(|r| r.q[1] * sign > 0.0).collect();
-        let holds = !rows.is_empty()
-            && rows.iter().all(|r| r.ours_delta()[wider] > r.ours_delta()[1 - wider]);
-        let mut evidence = String::from("ours (Δk_x, Δk_y):");
-        for r in &rows {
-            let d = r.ours_delta();
-            let _ = write!(
-                evidence,
-                " q = [{}, {}]: ({}, {});",
-                fixed(r.q[0], 3),
-                fixed(r.q[1], 3),
-                fixed(d[0], 2),
-                fixed(d[1], 2)
-            );
-        }
-        claims.push(Claim::checked(
-            format!(
-                "E1/E3: when q2 {} 0, {axis_name} has the wider range (Table II)",
-                if sign < 0.0 { "<" } else { ">" }
-            ),
-            holds,
-            evidence,
-        ));
-    }
+    // E1: the patterns of Table II, with the thresholds shared by calibration and tests.
+    let mut claims = table_2_patterns(table);
 
     // E2: tensions and stiffness rise together, linearly.
     if let (Some(first), Some(last)) = (e2.first(), e2.last()) {

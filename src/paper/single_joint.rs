@@ -1,32 +1,16 @@
 //! The single-joint experiments: Table II (E1), Fig. 4 (E2) and Fig. 5 (E3), on joint 1 of a
 //! robot with its routing (spec §6).
 
-use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 use crate::indicators::{AngleGrid, IndicatorError, JointProbe, SweepMaps, sweep_joint};
 use crate::robot::Robot;
 use crate::routing::Routing;
 
+use super::experiments::{
+    E2_Q, E2_TORQUE, E3_RANGE, E3_TORQUE, PAPER_TABLE_2, SINGLE_JOINT, TABLE_2_TORQUE,
+};
 use super::fixed;
-
-/// Torque held in E1 (Table II) and E3 (Fig. 5), N m.
-pub const TABLE_2_TORQUE: [f64; 2] = [0.3, 0.3];
-/// Torque held in E3 (Fig. 5), N m.
-pub const E3_TORQUE: [f64; 2] = [0.3, 0.3];
-/// E2's joint angles (Fig. 4), rad.
-pub const E2_Q: [f64; 2] = [PI / 7.0, -PI / 9.0];
-/// E2's torque (Fig. 4), N m.
-pub const E2_TORQUE: [f64; 2] = [-1.0, 0.5];
-
-/// Table II as printed: `(q, [K_x min, K_x max], [K_y min, K_y max])`, N m/rad.
-pub const PAPER_TABLE_2: [([f64; 2], [f64; 2], [f64; 2]); 5] = [
-    ([0.0, 0.0], [1.92, 1.98], [1.85, 1.90]),
-    ([PI / 6.0, PI / 6.0], [2.96, 7.94], [2.51, 10.59]),
-    ([PI / 6.0, -PI / 6.0], [2.53, 18.17], [1.44, 8.18]),
-    ([-PI / 6.0, PI / 6.0], [2.32, 7.50], [2.17, 10.57]),
-    ([-PI / 6.0, -PI / 6.0], [1.41, 17.05], [1.37, 8.11]),
-];
 
 /// One row of Table II: ours beside the paper's.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +33,15 @@ impl Table2Row {
     pub fn paper_delta(&self) -> [f64; 2] {
         [self.paper[0][1] - self.paper[0][0], self.paper[1][1] - self.paper[1][0]]
     }
+
+    /// The relative errors `(ours − paper) / paper` of the four interval ends:
+    /// `[K_x min, K_x max, K_y min, K_y max]`.
+    pub fn relative_errors(&self) -> [f64; 4] {
+        let e = |axis: usize, end: usize| {
+            (self.ours[axis][end] - self.paper[axis][end]) / self.paper[axis][end]
+        };
+        [e(0, 0), e(0, 1), e(1, 0), e(1, 1)]
+    }
 }
 
 /// Table II (E1) on joint 1 (index 0) of `robot` with `routing`.
@@ -56,7 +49,7 @@ impl Table2Row {
 /// # Errors
 /// An infeasible configuration or a geometry error.
 pub fn table_2(robot: &Robot, routing: &Routing) -> Result<Vec<Table2Row>, IndicatorError> {
-    let mut probe = JointProbe::new(robot, routing, 0)?;
+    let mut probe = JointProbe::new(robot, routing, SINGLE_JOINT)?;
     PAPER_TABLE_2
         .iter()
         .map(|&(q, kx, ky)| {
@@ -72,18 +65,12 @@ pub fn table_2(robot: &Robot, routing: &Routing) -> Result<Vec<Table2Row>, Indic
 
 /// RMS relative error of ours against the paper over the 20 interval ends.
 pub fn rms_relative_error(rows: &[Table2Row]) -> f64 {
-    let mut sum = 0.0;
-    let mut count = 0;
-    for row in rows {
-        for axis in 0..2 {
-            for end in 0..2 {
-                let e = (row.ours[axis][end] - row.paper[axis][end]) / row.paper[axis][end];
-                sum += e * e;
-                count += 1;
-            }
-        }
+    let errors: Vec<f64> = rows.iter().flat_map(Table2Row::relative_errors).collect();
+    if errors.is_empty() {
+        0.0
+    } else {
+        (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt()
     }
-    if count == 0 { 0.0 } else { (sum / count as f64).sqrt() }
 }
 
 fn q_label(q: [f64; 2]) -> String {
@@ -164,7 +151,7 @@ pub fn e2(
     routing: &Routing,
     samples: usize,
 ) -> Result<Vec<E2Point>, IndicatorError> {
-    let mut probe = JointProbe::new(robot, routing, 0)?;
+    let mut probe = JointProbe::new(robot, routing, SINGLE_JOINT)?;
     let range = probe.evaluate(robot, routing, E2_Q, E2_TORQUE)?;
     let samples = samples.max(2);
     Ok((0..samples)
@@ -204,9 +191,9 @@ pub fn e3(robot: &Robot, routing: &Routing, points: usize) -> Result<SweepMaps, 
     sweep_joint(
         robot,
         routing,
-        0,
+        SINGLE_JOINT,
         E3_TORQUE,
-        AngleGrid { lower: -PI / 6.0, upper: PI / 6.0, points },
+        AngleGrid { lower: E3_RANGE[0], upper: E3_RANGE[1], points },
     )
 }
 

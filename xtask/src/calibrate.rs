@@ -3,7 +3,8 @@
 //!
 //! # The model
 //! One universal joint of the platform (eq. 1) with its three cables in the paper's decoupled
-//! model, computed by the library ([`sinew::indicators::JointProbe`], the paper's single-joint model): at the five angles of
+//! model, computed by the library as the report computes it ([`sinew::paper::table_2`], through
+//! [`sinew::indicators::JointProbe`], the paper's single-joint model): at the five angles of
 //! Table II, holding `τ = [0.3, 0.3]` N m with tensions in `[20, 600]` N, the range of `K_x` and
 //! of `K_y` over the feasible tensions. The residuals are the 20 relative errors
 //! `(ours − paper) / paper`; a parameter set for which a configuration's torque cannot be held
@@ -29,22 +30,16 @@
 //! [`start_points`] and keeps the best. Deterministic; a few seconds in a debug build.
 
 use std::f64::consts::{FRAC_PI_3, PI, TAU};
-use std::fmt::Write as _;
 use std::path::Path;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra_lm::{DMatrix, DVector, Dyn, Owned};
-use sinew::indicators::JointProbe;
+use sinew::paper::{Table2Row, render_table_2, table_2_patterns};
 use sinew::robot::UniformChain;
 use sinew::routing::{PatternModel, PerJoint, Routing, RoutingSpec};
 
 use crate::DynResult;
 
-/// Table II as printed: `(q, [K_x min, K_x max], [K_y min, K_y max])`, N m/rad.
-/// Table II as printed (spec §6), the one copy in `sinew::paper`.
-const PAPER: [([f64; 2], [f64; 2], [f64; 2]); 5] = sinew::paper::PAPER_TABLE_2;
-/// Table II's torque, N m.
-const TORQUE: [f64; 2] = sinew::paper::TABLE_2_TORQUE;
 /// The relative error charged to each entry of a configuration that cannot hold the torque.
 const INFEASIBLE_RESIDUAL: f64 = 10.0;
 /// Gap between the two discs of a joint, d1 + d2, m (kept; see the module doc).
@@ -129,8 +124,9 @@ fn chain(g: &Geometry, joints: usize) -> UniformChain {
     UniformChain { d1: g.d1, d2: g.d2, ..UniformChain::like_cdhrm5(joints) }
 }
 
-/// Table II of a one-joint chain with geometry `g`: `[[K_x min, max], [K_y min, max]]` per row.
-fn table(g: &Geometry) -> DynResult<Vec<[[f64; 2]; 2]>> {
+/// Table II (the same computation as the report's, [`sinew::paper::table_2`]) of a one-joint
+/// chain with geometry `g`.
+fn table(g: &Geometry) -> DynResult<Vec<Table2Row>> {
     let chain = chain(g, 1);
     let robot = chain.build()?;
     let mut spec = RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled);
@@ -142,27 +138,12 @@ fn table(g: &Geometry) -> DynResult<Vec<[[f64; 2]; 2]>> {
         pattern.theta0 = g.theta0;
     }
     let routing = Routing::new(&robot, &spec, "<calibration>")?;
-    let mut probe = JointProbe::new(&robot, &routing, 0)?;
-    PAPER
-        .iter()
-        .map(|(q, _, _)| {
-            let range = probe.evaluate(&robot, &routing, *q, TORQUE)?;
-            Ok([range.sigma_x().range, range.sigma_y().range])
-        })
-        .collect()
+    Ok(sinew::paper::table_2(&robot, &routing)?)
 }
 
 /// The 20 relative errors, row by row: K_x min, K_x max, K_y min, K_y max.
-fn relative_errors(rows: &[[[f64; 2]; 2]]) -> Vec<f64> {
-    let mut r = Vec::with_capacity(20);
-    for (row, (_, kx, ky)) in rows.iter().zip(PAPER.iter()) {
-        for (axis, paper) in [kx, ky].into_iter().enumerate() {
-            for end in 0..2 {
-                r.push((row[axis][end] - paper[end]) / paper[end]);
-            }
-        }
-    }
-    r
+fn relative_errors(rows: &[Table2Row]) -> Vec<f64> {
+    rows.iter().flat_map(Table2Row::relative_errors).collect()
 }
 
 fn residuals(g: &Geometry) -> Vec<f64> {
@@ -494,73 +475,6 @@ fn tolerances(fit: &Fit) -> Vec<Option<f64>> {
     out
 }
 
-/// The qualitative patterns of Table II (spec §6 E1) in `rows`: `(statement, holds)`.
-pub fn patterns(rows: &[[[f64; 2]; 2]]) -> Vec<(&'static str, bool)> {
-    let delta = |r: &[[f64; 2]; 2], axis: usize| r[axis][1] - r[axis][0];
-    let zero = rows[0];
-    let others = &rows[1..];
-    let least_other =
-        others.iter().flat_map(|r| [delta(r, 0), delta(r, 1)]).fold(f64::INFINITY, f64::min);
-    let near_zero = delta(&zero, 0).max(delta(&zero, 1)) <= 0.05 * least_other;
-    // Rows 1..4 of PAPER: q2 > 0 at rows 1 and 3, q2 < 0 at rows 2 and 4.
-    let q2_negative = [2, 4].iter().all(|&i| delta(&rows[i], 0) > delta(&rows[i], 1));
-    let q2_positive = [1, 3].iter().all(|&i| delta(&rows[i], 1) > delta(&rows[i], 0));
-    let mainly_max = others.iter().all(|r| {
-        (0..2).all(|a| r[a][1] - zero[a][1] > (r[a][0] - zero[a][0]).abs() && r[a][1] > zero[a][1])
-    });
-    vec![
-        ("near-zero range at q = 0 (Δk ≤ 5 % of every other row's)", near_zero),
-        ("q2 < 0: K_x has the wider range", q2_negative),
-        ("q2 > 0: K_y has the wider range", q2_positive),
-        ("larger |q| raises mainly the maximum (max rises more than min moves)", mainly_max),
-    ]
-}
-
-fn q_label(q: [f64; 2]) -> String {
-    let part = |x: f64| match x.partial_cmp(&0.0) {
-        Some(std::cmp::Ordering::Greater) => "π/6",
-        Some(std::cmp::Ordering::Less) => "−π/6",
-        _ => "0",
-    };
-    format!("[{}, {}]", part(q[0]), part(q[1]))
-}
-
-/// Table II, ours beside the paper's, with the relative error of every interval end.
-fn render_table(rows: &[[[f64; 2]; 2]]) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "| q | K_x ours | K_x paper | error (min, max) | K_y ours | K_y paper | error (min, max) | Δk_x ours / paper | Δk_y ours / paper |"
-    );
-    let _ = writeln!(s, "| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
-    for (row, (q, kx, ky)) in rows.iter().zip(PAPER.iter()) {
-        let range = |r: [f64; 2]| format!("[{:.2}, {:.2}]", r[0], r[1]);
-        let err = |o: [f64; 2], p: [f64; 2]| {
-            format!(
-                "{:+.1} %, {:+.1} %",
-                100.0 * (o[0] - p[0]) / p[0],
-                100.0 * (o[1] - p[1]) / p[1]
-            )
-        };
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} / {:.2} | {:.2} / {:.2} |",
-            q_label(*q),
-            range(row[0]),
-            range(*kx),
-            err(row[0], *kx),
-            range(row[1]),
-            range(*ky),
-            err(row[1], *ky),
-            row[0][1] - row[0][0],
-            kx[1] - kx[0],
-            row[1][1] - row[1][0],
-            ky[1] - ky[0],
-        );
-    }
-    s
-}
-
 fn describe(g: &Geometry) -> String {
     let radius = if (g.rho_p - g.rho_d).abs() < 1e-9 {
         format!("ρ = {:.2} mm", 1e3 * g.rho_p)
@@ -646,15 +560,14 @@ pub fn run(args: &[String]) -> DynResult<()> {
     }
 
     println!("\nTable II with the values as written (rounded), ours beside the paper's:\n");
-    print!("{}", render_table(&rows));
-    println!("\nRMS relative error over the 20 entries: {:.2} %", 100.0 * rms(&errors));
+    print!("{}", render_table_2(&rows));
+    println!("RMS relative error over the 20 entries, to 0.01 %: {:.2} %", 100.0 * rms(&errors));
     let worst = errors.iter().fold(0.0_f64, |a, e| a.max(e.abs()));
     println!("Largest relative error: {:.1} %\n", 100.0 * worst);
-    println!("Qualitative patterns of Table II:\n");
-    let ours = patterns(&rows);
-    for (what, holds) in &ours {
-        println!("- {what}: {}", if *holds { "holds" } else { "DOES NOT HOLD" });
-    }
+    println!(
+        "Qualitative patterns of Table II (the report's check, `sinew::paper::table_2_patterns`):\n"
+    );
+    print!("{}", sinew::paper::render_claims(&table_2_patterns(&rows)));
 
     println!(
         "\nWhat the data constrain: refits from the best, each with one restriction lifted:\n"
