@@ -26,7 +26,7 @@
 mod error;
 pub mod paper;
 
-pub use error::Error;
+pub use error::{Error, ErrorKind};
 pub use sinew_indicators as indicators;
 pub use sinew_robot as robot;
 pub use sinew_routing as routing;

@@ -16,7 +16,7 @@ pub use arm::{
 pub use claims::{Claim, claims_e1_e3, render_claims};
 pub use single_joint::{
     E2_Q, E2_TORQUE, E2Point, E3_TORQUE, PAPER_TABLE_2, TABLE_2_TORQUE, Table2Row, e2, e2_csv, e3,
-    e3_csv, render_table_2, rms_relative_error, table_2,
+    e3_csv, e3_with_progress, render_table_2, rms_relative_error, table_2,
 };
 pub use table1::table_1;
 

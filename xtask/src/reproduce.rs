@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sinew::paper;
 
 use crate::{DynResult, plots};
@@ -20,6 +21,17 @@ const E2_SAMPLES: usize = 41;
 
 /// Which number of a sweep cell a heat map shows.
 type CellValue = fn(&sinew::indicators::SweepCell) -> f64;
+
+/// A progress bar for Fig. 5's sweep on standard error (drawn only on a terminal).
+fn sweep_bar(total: usize) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("fig. 5 sweep {bar:40} {pos}/{len} points ({eta} left)")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
 
 struct Output {
     dir: PathBuf,
@@ -90,7 +102,12 @@ fn write_report(root: &Path, dir: PathBuf) -> DynResult<Vec<PathBuf>> {
     let table_1 = paper::table_1(&robot_dir)?;
     let table_2 = paper::table_2(&robot, &routing)?;
     let e2 = paper::e2(&robot, &routing, E2_SAMPLES)?;
-    let e3 = paper::e3(&robot, &routing, FIG5_POINTS)?;
+    let bar = sweep_bar(FIG5_POINTS * FIG5_POINTS);
+    let e3 = paper::e3_with_progress(&robot, &routing, FIG5_POINTS, &|done, _| {
+        bar.set_position(done as u64)
+    });
+    bar.finish_and_clear();
+    let e3 = e3?;
     let claims = paper::claims_e1_e3(&table_2, &e2, &e3);
     let routed = sinew::routing::load(robot_dir.join("cables-routed.toml"), &robot)?;
     let e4 = [

@@ -436,7 +436,7 @@ fn sweep_json_and_csv_equal_the_library() {
     ]);
     let x = &fx.robot.joints()[0];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 5 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid).unwrap();
+    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap();
     assert_eq!(doc["joint"], 0);
     assert_eq!(doc["grid"]["points"], 5);
     let angles: Vec<f64> = (0..5).map(|k| grid.angle(k)).collect();
@@ -480,7 +480,7 @@ fn sweep_marks_infeasible_points_null() {
     ]);
     let x = &fx.robot.joints()[2];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 3 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [6.0, 0.0], grid).unwrap();
+    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [6.0, 0.0], grid, &|_, _| {}).unwrap();
     assert_eq!(doc["feasible"], maps.feasible());
     let nulls = doc["k_x_min"].as_array().unwrap().iter().flat_map(|r| r.as_array().unwrap());
     assert_eq!(nulls.filter(|v| v.is_null()).count(), 9 - maps.feasible());
