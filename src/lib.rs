@@ -18,7 +18,8 @@
 //!
 //! [`paper`] holds the paper's experiments (spec §6) as data, checks and fixed-precision
 //! tables, for `cargo xtask reproduce` and the snapshot tests; [`Error`] gathers every crate's
-//! error.
+//! error, each by one path, and [`Error::kind`] says what kind of failure it is ([`ErrorKind`]:
+//! input, infeasible, unstable, rank-deficient, numerical).
 //!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
@@ -26,7 +27,7 @@
 mod error;
 pub mod paper;
 
-pub use error::Error;
+pub use error::{Error, ErrorKind};
 pub use sinew_indicators as indicators;
 pub use sinew_robot as robot;
 pub use sinew_routing as routing;

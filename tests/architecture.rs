@@ -3,6 +3,8 @@
 //! (a backticked `a/b/...` rooted at a top-level folder, or a backticked `file.rs` inside a
 //! crate's section) exists.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 

@@ -34,7 +34,8 @@ pub use report::{
     FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, ROUTED_FILE, Report,
 };
 pub use single_joint::{
-    E2Point, Table2Row, e2, e2_csv, e3, e3_csv, render_table_2, rms_relative_error, table_2,
+    E2Point, Table2Row, e2, e2_csv, e3, e3_csv, e3_with_progress, render_table_2,
+    rms_relative_error, table_2,
 };
 pub use table1::table_1;
 

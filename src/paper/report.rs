@@ -13,7 +13,9 @@ use crate::routing::Routing;
 use super::arm::{E4, claims_e4_end, claims_e4_joints, e4, render_e4, render_routed_vs_decoupled};
 use super::claims::{Claim, claims_e1_e3, render_claims};
 use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE};
-use super::single_joint::{E2Point, Table2Row, e2, e2_csv, e3, e3_csv, render_table_2, table_2};
+use super::single_joint::{
+    E2Point, Table2Row, e2, e2_csv, e3_csv, e3_with_progress, render_table_2, table_2,
+};
 use super::table1::table_1;
 
 /// The robot folder of the report, relative to the workspace root.
@@ -109,13 +111,25 @@ impl Report {
     /// A file that cannot be read or a routing the experiments cannot handle; infeasible or
     /// unstable E4 cases are results, not errors.
     pub fn compute(robot_dir: &Path) -> Result<Report, crate::Error> {
+        Report::compute_with_progress(robot_dir, &|_, _| {})
+    }
+
+    /// [`Report::compute`], reporting the Fig. 5 sweep's `progress(done, total)` as it goes
+    /// (`cargo xtask reproduce` draws it as a progress bar on a terminal).
+    ///
+    /// # Errors
+    /// As [`Report::compute`].
+    pub fn compute_with_progress(
+        robot_dir: &Path,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Report, crate::Error> {
         let robot = crate::robot::load(robot_dir)?;
         let routing = crate::routing::load(robot_dir, &robot)?;
         let routed = crate::routing::load(robot_dir.join(ROUTED_FILE), &robot)?;
         let table_1 = table_1(robot_dir)?;
         let table_2 = table_2(&robot, &routing)?;
         let e2 = e2(&robot, &routing, E2_SAMPLES)?;
-        let e3 = e3(&robot, &routing, E3_POINTS)?;
+        let e3 = e3_with_progress(&robot, &routing, E3_POINTS, progress)?;
         let claims_e1_e3 = claims_e1_e3(&table_2, &e2, &e3);
         let e4_decoupled = e4(&robot, &routing, "decoupled", E4_PAPER_BASELINE)?;
         let e4_routed = e4(&robot, &routed, "routed", E4_PAPER_BASELINE)?;

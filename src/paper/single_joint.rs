@@ -188,12 +188,27 @@ pub fn e2_csv(points: &[E2Point]) -> String {
 /// # Errors
 /// Geometry errors (infeasible points are `None` in the maps).
 pub fn e3(robot: &Robot, routing: &Routing, points: usize) -> Result<SweepMaps, IndicatorError> {
+    e3_with_progress(robot, routing, points, &|_, _| {})
+}
+
+/// [`e3`], reporting `progress(done, total)` points as the sweep goes (see
+/// [`sweep_joint`]; `cargo xtask reproduce` draws it as a progress bar).
+///
+/// # Errors
+/// As [`e3`].
+pub fn e3_with_progress(
+    robot: &Robot,
+    routing: &Routing,
+    points: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<SweepMaps, IndicatorError> {
     sweep_joint(
         robot,
         routing,
         SINGLE_JOINT,
         E3_TORQUE,
         AngleGrid { lower: E3_RANGE[0], upper: E3_RANGE[1], points },
+        progress,
     )
 }
 

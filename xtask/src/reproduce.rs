@@ -8,9 +8,21 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sinew::paper::{self, REPORT_DIR, Report};
 
 use crate::{DynResult, plots};
+
+/// A progress bar for Fig. 5's sweep on standard error (drawn only on a terminal).
+fn sweep_bar(total: usize) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("fig. 5 sweep {bar:40} {pos}/{len} points ({eta} left)")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
 
 struct Output {
     dir: PathBuf,
@@ -95,7 +107,12 @@ fn write_report(root: &Path, dir: PathBuf) -> DynResult<Vec<PathBuf>> {
     std::fs::create_dir_all(&out.dir)?;
 
     let started = Instant::now();
-    let report = Report::compute(&root.join(paper::ROBOT_DIR))?;
+    let bar = sweep_bar(paper::E3_POINTS * paper::E3_POINTS);
+    let report = Report::compute_with_progress(&root.join(paper::ROBOT_DIR), &|done, _| {
+        bar.set_position(done as u64)
+    });
+    bar.finish_and_clear();
+    let report = report?;
     let computed = started.elapsed();
 
     for (name, text) in report.text_files() {

@@ -6,7 +6,7 @@ use sinew::indicators::StiffnessEllipsoid;
 use sinew::stiffness::{ArmStiffness, StiffnessError, stability_margin};
 
 use crate::cli::ArmArgs;
-use crate::error::{CliError, model_error};
+use crate::error::{CliError, library_error};
 use crate::input::{check_limits, load, numbers_n, to_radians};
 use crate::output::{
     Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, na_vec, print_json,
@@ -102,13 +102,8 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         )?,
         None => vec![0.0; joints],
     };
-    if let Some((i, s)) = levels.iter().enumerate().find(|(_, s)| !(0.0..=1.0).contains(*s)) {
-        return Err(CliError::input(format!(
-            "--levels: level {s} of joint {} is outside [0, 1]",
-            i + 1
-        )));
-    }
-    let arm = ArmStiffness::new(routing).map_err(CliError::input)?;
+    // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
+    let arm = ArmStiffness::new(routing).map_err(library_error)?;
     let mut data = arm.data(robot, routing);
     let f0 = Vector6::from_column_slice(&wrench);
     let mut notes = Vec::new();
@@ -127,9 +122,9 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
             notes.push(format!("{e}: k_x, k_fd and the ellipsoid are null"));
             (true, false)
         }
-        Err(e) => return Err(model_error(e)),
+        Err(e) => return Err(library_error(e)),
     };
-    let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(model_error)?;
+    let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(library_error)?;
     let c_x = stable.then(|| faer_rows(data.compliance()));
     // (C_x[0:3, 0:3])⁻¹: None where that block is singular (same tolerance as K_x's).
     let k_translational = if stable { data.translational_stiffness() } else { None };
@@ -142,7 +137,7 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     }
     let (k_x, k_fd, ellipsoid) = if full_rank {
         let k_fd = data.k_fd();
-        let ellipsoid = StiffnessEllipsoid::new(&k_fd).map_err(model_error)?;
+        let ellipsoid = StiffnessEllipsoid::new(&k_fd).map_err(library_error)?;
         let e = EllipsoidOut {
             eigenvalues: na_vec(&ellipsoid.eigenvalues),
             directions: na_rows(&ellipsoid.directions.transpose()),

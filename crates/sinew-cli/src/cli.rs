@@ -26,8 +26,9 @@ pub enum Command {
     Routing(RoutingArgs),
     /// One universal joint alone: its feasible tension interval and stiffness range (eq. 20).
     ///
-    /// The paper's single-joint model: the joint's own three cables hold the torque, the
-    /// other joints stay at 0 with slack cables. Prints λ_min and λ_max (eq. 22–23), the
+    /// The paper's single-joint model: the joint's own three cables hold the torque (the only
+    /// cables with tension), the other joints stay at 0; the inherent stiffness counts every
+    /// cable crossing the joint (routed: the distal joints' cables too). Prints λ_min and λ_max (eq. 22–23), the
     /// tensions at both ends, the controllable, inherent and total 2 × 2 stiffness at both
     /// ends, and σ_x, σ_y = [[K_min, K_max], Δk].
     Joint(JointArgs),
@@ -43,7 +44,8 @@ pub enum Command {
     /// A joint's stiffness range over a grid of its two angles (Fig. 5 maps).
     ///
     /// N × N points over the joint's angle limits (both axes), the other joints at 0: the
-    /// minimum and maximum of K_x and of K_y over the feasible tensions at each point, empty
+    /// minimum and maximum of K_x and of K_y (about the first and the second axis) over the
+    /// feasible tensions at each point, empty
     /// (null in JSON) where the torque cannot be held.
     Sweep(SweepArgs),
 }
@@ -103,10 +105,11 @@ pub struct JointArgs {
     #[command(flatten)]
     pub common: Common,
     /// Universal joint, numbered from 1 at the base (the paper's numbering; JSON `joint` is
-    /// 0-based). The other joints stay at 0 and their cables slack.
+    /// 0-based). The other joints stay at 0 and their cables at zero tension.
     #[arg(long, value_name = "I", allow_hyphen_values = true)]
     pub joint: String,
-    /// The joint's two angles, about x then y: Q1,Q2 (rad; degrees with --deg).
+    /// The joint's two angles, about its first then its second revolute joint (the URDF's
+    /// order, any axes): Q1,Q2 (rad; degrees with --deg).
     #[arg(long, value_name = "Q1,Q2", allow_hyphen_values = true)]
     pub q: String,
     /// The torque the joint's three cables hold: T1,T2 (N m).
@@ -122,8 +125,8 @@ pub struct JointArgs {
 pub struct ArmArgs {
     #[command(flatten)]
     pub common: Common,
-    /// The pose: 2n angles Q1,...,Q2n, base first, x then y for each joint (rad; degrees
-    /// with --deg).
+    /// The pose: 2n angles Q1,...,Q2n, base first, the first then the second axis of each
+    /// universal joint (rad; degrees with --deg).
     #[arg(long, value_name = "Q1,...,Q2n", allow_hyphen_values = true)]
     pub q: String,
     /// F0, the wrench the end-effector exerts on its environment, base frame:
@@ -154,7 +157,8 @@ pub struct SweepArgs {
     /// The torque the joint's three cables hold: T1,T2 (N m).
     #[arg(long, value_name = "T1,T2", allow_hyphen_values = true)]
     pub torque: String,
-    /// Grid points per axis (≥ 2) over the joint's angle limits.
+    /// Grid points per axis (2 to 1001: time and output grow as N²) over the joint's angle
+    /// limits.
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub grid: String,
     /// Write the maps as CSV (q1_rad,q2_rad,k_x_min,k_x_max,k_y_min,k_y_max; empty fields

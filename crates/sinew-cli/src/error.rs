@@ -1,71 +1,96 @@
-//! The command's errors: one line on standard error and an exit code.
+//! The command's errors: one line on standard error and an exit code from the error's kind.
 
 use std::fmt;
 
+use sinew::ErrorKind;
+use sinew::indicators::IndicatorError;
+use sinew::robot::RobotError;
+use sinew::statics::StaticsError;
+
 /// Exit code for bad input: options, counts, joint numbers, angles outside the limits, robot
-/// files (clap's own usage errors exit with 2 as well).
+/// files ([`ErrorKind::Input`]; clap's own usage errors exit with 2 as well).
 pub const EXIT_INPUT: u8 = 2;
 /// Exit code when the input is valid but the model has no answer: an infeasible load, lost
-/// force closure, a degenerate geometry, a numerical failure.
+/// force closure ([`ErrorKind::Infeasible`]), an unstable or rank-deficient end where no
+/// result can stand in for it ([`ErrorKind::Unstable`], [`ErrorKind::RankDeficient`]), a
+/// degenerate geometry or a numerical failure ([`ErrorKind::Numerical`]).
 pub const EXIT_MODEL: u8 = 1;
+
+/// The exit code of an error of this kind: [`EXIT_INPUT`] for input, [`EXIT_MODEL`] for the
+/// rest.
+pub fn exit_code(kind: ErrorKind) -> u8 {
+    match kind {
+        ErrorKind::Input => EXIT_INPUT,
+        _ => EXIT_MODEL,
+    }
+}
 
 /// An error of the command, printed as `sinew: <message>`.
 #[derive(Debug)]
-pub enum CliError {
-    /// Bad input (exit 2).
-    Input(String),
-    /// The model has no answer (exit 1).
-    Model(String),
+pub struct CliError {
+    /// What kind of failure (gives the exit code).
+    pub kind: ErrorKind,
+    /// The message, possibly multi-line (printed on one line).
+    pub message: String,
 }
 
 impl CliError {
     /// Bad input, from anything printable.
     pub fn input(message: impl fmt::Display) -> CliError {
-        CliError::Input(message.to_string())
+        CliError { kind: ErrorKind::Input, message: message.to_string() }
     }
 
-    /// No answer from the model, from anything printable.
+    /// No answer from the model (a numerical failure), from anything printable.
     pub fn model(message: impl fmt::Display) -> CliError {
-        CliError::Model(message.to_string())
+        CliError { kind: ErrorKind::Numerical, message: message.to_string() }
     }
 
     /// The process exit code.
     pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Input(_) => EXIT_INPUT,
-            CliError::Model(_) => EXIT_MODEL,
-        }
+        exit_code(self.kind)
     }
 
     /// The message on one line (library messages may quote a multi-line parser report).
     pub fn one_line(&self) -> String {
-        let message = match self {
-            CliError::Input(m) | CliError::Model(m) => m,
-        };
-        one_line(message)
+        one_line(&self.message)
     }
 }
 
-/// A library error met while computing (exit 1); an infeasible load says so first.
-pub fn model_error(e: impl Into<sinew::Error>) -> CliError {
+/// A library error: its kind gives the exit code; the message is the library's, prefixed by
+/// the option the faulty value came from when the error says which (`--q`, `--levels`,
+/// `--joint N`, `--grid N`), and an infeasible load says so first.
+pub fn library_error(e: impl Into<sinew::Error>) -> CliError {
     let e: sinew::Error = e.into();
-    let infeasible = match &e {
-        sinew::Error::Statics(s) => is_infeasible(s),
-        sinew::Error::Stiffness(s) => {
-            matches!(&**s, sinew::stiffness::StiffnessError::Statics(s) if is_infeasible(s))
-        }
-        sinew::Error::Indicators(sinew::indicators::IndicatorError::Statics(s)) => is_infeasible(s),
-        _ => false,
+    let kind = e.kind();
+    let message = match (kind, option_of(&e)) {
+        (ErrorKind::Infeasible, _) => format!("infeasible load: {e}"),
+        (_, Some(option)) => format!("{option}: {e}"),
+        (_, None) => e.to_string(),
     };
-    if infeasible {
-        CliError::Model(format!("infeasible load: {e}"))
-    } else {
-        CliError::Model(e.to_string())
-    }
+    CliError { kind, message }
 }
 
-fn is_infeasible(e: &sinew::statics::StaticsError) -> bool {
-    matches!(e, sinew::statics::StaticsError::Infeasible { .. })
+/// The command-line option whose value a library input error is about, if it names one.
+fn option_of(e: &sinew::Error) -> Option<String> {
+    match e {
+        sinew::Error::Robot(RobotError::OutOfLimits { .. } | RobotError::NonFiniteAngle { .. }) => {
+            Some("--q".to_owned())
+        }
+        sinew::Error::Statics(s) => match &**s {
+            StaticsError::InvalidLevel { .. } => Some("--levels".to_owned()),
+            StaticsError::NonFiniteWrench { .. } => Some("--wrench".to_owned()),
+            StaticsError::NonFiniteTorque { .. } => Some("--torque".to_owned()),
+            _ => None,
+        },
+        sinew::Error::Indicators(i) => match i {
+            IndicatorError::NoSuchJoint { joint, .. } => Some(format!("--joint {}", joint + 1)),
+            IndicatorError::NotThreeCables { joint, .. } => Some(format!("--joint {}", joint + 1)),
+            IndicatorError::GridTooSmall { points, .. } => Some(format!("--grid {points}")),
+            IndicatorError::GridRange { .. } => Some("--joint (its angle limits)".to_owned()),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// Collapse a message to one line: the lines trimmed and joined with ` | `, dropping empty
@@ -83,5 +108,32 @@ pub fn one_line(message: &str) -> String {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.one_line())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_map_to_the_documented_exit_codes() {
+        assert_eq!(exit_code(ErrorKind::Input), 2);
+        for kind in [
+            ErrorKind::Infeasible,
+            ErrorKind::Unstable,
+            ErrorKind::RankDeficient,
+            ErrorKind::Numerical,
+        ] {
+            assert_eq!(exit_code(kind), 1, "{kind}");
+        }
+    }
+
+    #[test]
+    fn library_input_errors_name_the_option() {
+        let e = library_error(StaticsError::InvalidLevel { joint: 2, level: 1.5 });
+        assert_eq!(e.kind, ErrorKind::Input);
+        assert!(e.message.starts_with("--levels: joint 3"), "{}", e.message);
+        let e = library_error(IndicatorError::NoSuchJoint { joint: 8, joints: 5 });
+        assert!(e.message.starts_with("--joint 9: "), "{}", e.message);
     }
 }

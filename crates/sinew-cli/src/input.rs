@@ -7,7 +7,7 @@ use sinew::robot::{DESCRIPTION_FILE, Robot, RobotDescription, RobotError};
 use sinew::routing::Routing;
 
 use crate::cli::Model;
-use crate::error::CliError;
+use crate::error::{CliError, library_error};
 
 /// A robot folder, loaded: its description, the robot and the routing of the chosen model.
 #[derive(Debug)]
@@ -40,7 +40,7 @@ pub fn load(dir: &Path, model: Model, no_gravity: bool) -> Result<Loaded, CliErr
             "--robot: robot folder `{shown}` has no {DESCRIPTION_FILE}"
         )));
     }
-    let description = RobotDescription::read(dir).map_err(CliError::input)?;
+    let description = RobotDescription::read(dir).map_err(library_error)?;
     if !description.urdf.is_file() {
         return Err(CliError::input(format!(
             "--robot: robot folder `{shown}` has no URDF: {} names `{}`, which does not exist",
@@ -53,7 +53,7 @@ pub fn load(dir: &Path, model: Model, no_gravity: bool) -> Result<Loaded, CliErr
         RobotError::NoSuchLink { .. } => {
             CliError::input(format!("{}: tip_link: {e}", description.path.display()))
         }
-        e => CliError::input(e),
+        e => library_error(e),
     })?;
     let routing_file = dir.join(model.file_name());
     if !routing_file.is_file() {
@@ -63,7 +63,7 @@ pub fn load(dir: &Path, model: Model, no_gravity: bool) -> Result<Loaded, CliErr
             model.file_name()
         )));
     }
-    let routing = sinew::routing::load(&routing_file, &robot).map_err(CliError::input)?;
+    let routing = sinew::routing::load(&routing_file, &robot).map_err(library_error)?;
     let robot = if no_gravity { robot.with_gravity(Vector3::zeros()) } else { robot };
     Ok(Loaded { description, robot, routing, routing_file })
 }
@@ -97,20 +97,21 @@ pub fn numbers_n(option: &str, text: &str, count: usize, what: &str) -> Result<V
     Ok(values)
 }
 
-/// A 1-based universal joint number of the command line, checked against the robot, as the
-/// 0-based index.
+/// A 1-based universal joint number of the command line, as the 0-based index. Only the
+/// command line's numbering is checked here (a whole number from 1); whether the robot has
+/// that joint is the library's to say (`--joint N: joint N does not exist …`).
 pub fn joint(text: &str, robot: &Robot) -> Result<usize, CliError> {
     let joints = robot.dof() / 2;
     let number: i64 = text.trim().parse().map_err(|_| {
         CliError::input(format!("--joint: `{}` is not a joint number (1 to {joints})", text.trim()))
     })?;
-    if number < 1 || number > joints as i64 {
+    if number < 1 {
         return Err(CliError::input(format!(
             "--joint {number}: no such joint; the robot `{}` has {joints} universal joints, numbered 1 to {joints} from the base",
             robot.name()
         )));
     }
-    Ok((number - 1) as usize)
+    usize::try_from(number - 1).map_err(|_| CliError::input(format!("--joint {number}: too large")))
 }
 
 /// Angles to radians.
@@ -122,7 +123,8 @@ pub fn to_radians(values: &mut [f64], deg: bool) {
     }
 }
 
-/// Check a full configuration against the joint limits (an input error naming the joint).
+/// Check a full configuration against the joint limits, for the arm (whose evaluation does
+/// not): the library's error, `--q: joint …`.
 pub fn check_limits(robot: &Robot, q: &[f64]) -> Result<(), CliError> {
-    robot.check_limits(q).map_err(|e| CliError::input(format!("--q: {e}")))
+    robot.check_limits(q).map_err(library_error)
 }

@@ -4,7 +4,7 @@ use serde::Serialize;
 use sinew::indicators::{Indicator, JointProbe};
 
 use crate::cli::JointArgs;
-use crate::error::{CliError, model_error};
+use crate::error::{CliError, library_error};
 use crate::input::{joint, load, numbers_n, to_radians};
 use crate::output::{Fmt, Rows, Table, emit, na_rows, na_vec, print_json};
 
@@ -17,8 +17,18 @@ struct JointOut {
     model: &'static str,
     /// 0-based.
     joint: usize,
-    /// Names of the joint's three cables (the order of every tension vector).
+    /// Names of the joint's own three cables (the order of every tension vector): the only
+    /// cables with tension (every other cable at zero), so the only ones in the controllable
+    /// part `Σ f_c H_c`.
     cables: Vec<String>,
+    /// The cables in the inherent part `J_cᵀ K_l J_c`: every cable crossing the joint (the
+    /// same three when decoupled; routed, also the distal joints' cables, elastic at zero
+    /// tension).
+    inherent_cables: Vec<String>,
+    /// The joint's two revolute joints (URDF names and unit axes): `q`, `torque` and the
+    /// rows/columns of every 2 × 2 matrix are about the first then the second; `sigma_x` and
+    /// `sigma_y` (the paper's names) are the first and the second axis.
+    axes: [AxisOut; 2],
     q: [f64; 2],
     torque: [f64; 2],
     tension_limits: [f64; 2],
@@ -39,6 +49,24 @@ struct JointOut {
     sigma_y: ([f64; 2], f64),
 }
 
+/// One of a universal joint's two revolute joints.
+#[derive(Debug, Serialize)]
+pub struct AxisOut {
+    /// The URDF joint's name.
+    pub name: String,
+    /// Its unit axis, in its joint frame.
+    pub axis: [f64; 3],
+}
+
+/// The two axes of universal joint `i` (0-based, checked).
+pub fn axes(robot: &sinew::robot::Robot, i: usize) -> [AxisOut; 2] {
+    let axis = |k: usize| {
+        let j = &robot.joints()[k];
+        AxisOut { name: j.name.clone(), axis: [j.axis.x, j.axis.y, j.axis.z] }
+    };
+    [axis(2 * i), axis(2 * i + 1)]
+}
+
 fn sigma(i: Indicator) -> ([f64; 2], f64) {
     (i.range, i.delta)
 }
@@ -48,19 +76,18 @@ pub fn run(args: &JointArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, false)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
     let i = joint(&args.joint, robot)?;
-    let mut q = numbers_n("--q", &args.q, 2, "angles (the joint's q_x,q_y)")?;
+    // The library says whether the robot has this joint (and whether it has three cables).
+    let mut probe = JointProbe::new(robot, routing, i).map_err(library_error)?;
+    let mut q = numbers_n("--q", &args.q, 2, "angles (about the joint's first and second axis)")?;
     to_radians(&mut q, args.deg);
     let tau = numbers_n("--torque", &args.torque, 2, "torque components (T1,T2 in N m)")?;
-    // The other joints stay at zero: check the full configuration for a clear message.
-    let mut full = vec![0.0; robot.dof()];
-    full[2 * i] = q[0];
-    full[2 * i + 1] = q[1];
-    crate::input::check_limits(robot, &full)?;
-    let mut probe = JointProbe::new(robot, routing, i).map_err(CliError::input)?;
+    // Angles outside the limits are the library's to refuse (`--q: joint … outside its limits`).
     let range =
-        probe.evaluate(robot, routing, [q[0], q[1]], [tau[0], tau[1]]).map_err(model_error)?;
-    let cables: Vec<String> =
-        routing.cables().iter().filter(|c| c.joint == i).map(|c| c.name.clone()).collect();
+        probe.evaluate(robot, routing, [q[0], q[1]], [tau[0], tau[1]]).map_err(library_error)?;
+    let names = |cables: &[usize]| -> Vec<String> {
+        cables.iter().map(|&c| routing.cables()[c].name.clone()).collect()
+    };
+    let cables: Vec<String> = names(&probe.tensioned_cables().collect::<Vec<_>>());
     let interval = &range.interval;
     let (f_lo, f_hi) = interval.ends();
     let out = JointOut {
@@ -69,7 +96,9 @@ pub fn run(args: &JointArgs) -> Result<(), CliError> {
         routing_file: loaded.routing_file.display().to_string(),
         model: args.common.model.name(),
         joint: i,
+        inherent_cables: names(probe.inherent_cables()),
         cables,
+        axes: axes(robot, i),
         q: [q[0], q[1]],
         torque: [tau[0], tau[1]],
         tension_limits: routing.tension_limits(),
@@ -89,11 +118,23 @@ pub fn run(args: &JointArgs) -> Result<(), CliError> {
 fn render(out: &JointOut) -> String {
     let mut s = String::new();
     s.push_str(&format!(
-        "joint {} of `{}` alone ({}: {}), the other joints at 0 with slack cables\n",
+        "joint {} of `{}` alone ({}: {}), the other joints at 0\n",
         out.joint + 1,
         out.robot,
         out.model,
         out.routing_file
+    ));
+    s.push_str(&format!(
+        "  axes: x = first `{}` {}, y = second `{}` {}\n",
+        out.axes[0].name,
+        Fmt::Fixed(3).list(&out.axes[0].axis),
+        out.axes[1].name,
+        Fmt::Fixed(3).list(&out.axes[1].axis)
+    ));
+    s.push_str(&format!(
+        "  tension in {} only (the other cables at 0); inherent stiffness of {}\n",
+        out.cables.join(", "),
+        out.inherent_cables.join(", ")
     ));
     s.push_str(&format!(
         "  q = {} rad, torque = {} N m, tensions in [{}, {}] N\n\n",
@@ -115,7 +156,7 @@ fn render(out: &JointOut) -> String {
         t.row(row);
     }
     s.push_str(&t.render(2));
-    s.push_str("\nJoint stiffness K = controllable + inherent (N m/rad, rows/columns x, y):\n");
+    s.push_str("\nJoint stiffness K = controllable + inherent (N m/rad, rows/columns first, second axis):\n");
     let mut t = Table::new(&["", "controllable", "", "inherent", "", "K", ""]);
     for (end, label) in ["at λ_min", "at λ_max"].iter().enumerate() {
         for r in 0..2 {

@@ -2,13 +2,21 @@
 
 use std::io::Write;
 
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
-use sinew::indicators::{AngleGrid, SweepCell, SweepMaps, sweep_joint};
+use sinew::indicators::{AngleGrid, JointProbe, SweepCell, SweepMaps, sweep_joint};
+use sinew::robot::Compact;
 
 use crate::cli::SweepArgs;
-use crate::error::{CliError, model_error};
+use crate::error::{CliError, library_error};
 use crate::input::{joint, load, numbers_n};
+use crate::joint_cmd::{AxisOut, axes};
 use crate::output::{Fmt, Table, emit, print_json};
+
+/// The most grid points per axis `sinew sweep` accepts: 1001² ≈ 10⁶ points. Time, memory and
+/// output grow as N² (about 100 bytes of JSON or table text per point and map), so a larger
+/// grid takes minutes to hours and gigabytes; 100 000 points per axis would be 10¹⁰ points.
+pub const MAX_GRID_POINTS: usize = 1001;
 
 /// The JSON document of `sinew sweep`.
 #[derive(Debug, Serialize)]
@@ -19,6 +27,10 @@ struct SweepOut {
     model: &'static str,
     /// 0-based.
     joint: usize,
+    /// The joint's two revolute joints: q1 (rows) about the first, q2 (columns) about the
+    /// second; `k_x_*` and `k_y_*` (the paper's names) are the stiffness about the first and
+    /// the second axis.
+    axes: [AxisOut; 2],
     torque: [f64; 2],
     tension_limits: [f64; 2],
     grid: GridOut,
@@ -51,18 +63,18 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let points: usize = args.grid.trim().parse().map_err(|_| {
         CliError::input(format!("--grid: `{}` is not a whole number of points", args.grid.trim()))
     })?;
-    if points < 2 {
-        return Err(CliError::input(format!("--grid {points}: need at least 2 points per axis")));
-    }
-    // Both axes share one grid: the range the joint's x and y axes both allow.
-    let (jx, jy) = (&robot.joints()[2 * i], &robot.joints()[2 * i + 1]);
-    let (lower, upper) = (jx.lower.max(jy.lower), jx.upper.min(jy.upper));
-    if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+    if points > MAX_GRID_POINTS {
         return Err(CliError::input(format!(
-            "--joint {}: its angle limits [{lower}, {upper}] rad do not give a finite grid",
-            i + 1
+            "--grid {points}: at most {MAX_GRID_POINTS} points per axis; the sweep's time, memory and output grow as N² ({} points asked for)",
+            Compact((points as f64).powi(2))
         )));
     }
+    // The library says whether the robot has this joint (and whether it has three cables);
+    // too few points and an empty range are its to refuse too.
+    JointProbe::new(robot, routing, i).map_err(library_error)?;
+    // Both axes share one grid: the range the joint's first and second axes both allow.
+    let (jx, jy) = (&robot.joints()[2 * i], &robot.joints()[2 * i + 1]);
+    let (lower, upper) = (jx.lower.max(jy.lower), jx.upper.min(jy.upper));
     let grid = AngleGrid { lower, upper, points };
     let cannot_write = |path: &std::path::Path, e: std::io::Error| {
         CliError::input(format!("--out: cannot write `{}`: {e}", path.display()))
@@ -72,7 +84,12 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         Some(path) => Some((path, std::fs::File::create(path).map_err(|e| cannot_write(path, e))?)),
         None => None,
     };
-    let maps = sweep_joint(robot, routing, i, [tau[0], tau[1]], grid).map_err(model_error)?;
+    let bar = progress_bar(points.saturating_mul(points));
+    let maps = sweep_joint(robot, routing, i, [tau[0], tau[1]], grid, &|done, _| {
+        bar.set_position(done as u64)
+    });
+    bar.finish_and_clear();
+    let maps = maps.map_err(library_error)?;
     if let Some((path, mut file)) = csv_file {
         file.write_all(sinew::paper::e3_csv(&maps).as_bytes())
             .map_err(|e| cannot_write(path, e))?;
@@ -86,6 +103,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         routing_file: loaded.routing_file.display().to_string(),
         model: args.common.model.name(),
         joint: i,
+        axes: axes(robot, i),
         torque: [tau[0], tau[1]],
         tension_limits: routing.tension_limits(),
         grid: GridOut {
@@ -102,6 +120,17 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         csv: args.out.as_ref().map(|p| p.display().to_string()),
     };
     if args.common.json { print_json(&out) } else { emit(&render(&out, &maps, args.out.is_none())) }
+}
+
+/// A progress bar on standard error, drawn only when it is a terminal.
+fn progress_bar(total: usize) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("sweep {bar:40} {pos}/{len} points ({eta} left)")
+    {
+        bar.set_style(style);
+    }
+    bar
 }
 
 fn render(out: &SweepOut, maps: &SweepMaps, with_maps: bool) -> String {
@@ -123,6 +152,13 @@ fn render(out: &SweepOut, maps: &SweepMaps, with_maps: bool) -> String {
         Fmt::Fixed(5).num(out.grid.upper),
         out.feasible,
         n * n
+    ));
+    s.push_str(&format!(
+        "  axes: q1, K_x about the first `{}` {}; q2, K_y about the second `{}` {}\n",
+        out.axes[0].name,
+        Fmt::Fixed(3).list(&out.axes[0].axis),
+        out.axes[1].name,
+        Fmt::Fixed(3).list(&out.axes[1].axis)
     ));
     let extremes = |m: &Vec<Vec<Option<f64>>>| {
         let values = m.iter().flatten().flatten().copied();

@@ -436,7 +436,7 @@ fn sweep_json_and_csv_equal_the_library() {
     ]);
     let x = &fx.robot.joints()[0];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 5 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid).unwrap();
+    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap();
     assert_eq!(doc["joint"], 0);
     assert_eq!(doc["grid"]["points"], 5);
     let angles: Vec<f64> = (0..5).map(|k| grid.angle(k)).collect();
@@ -480,7 +480,7 @@ fn sweep_marks_infeasible_points_null() {
     ]);
     let x = &fx.robot.joints()[2];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 3 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [6.0, 0.0], grid).unwrap();
+    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [6.0, 0.0], grid, &|_, _| {}).unwrap();
     assert_eq!(doc["feasible"], maps.feasible());
     let nulls = doc["k_x_min"].as_array().unwrap().iter().flat_map(|r| r.as_array().unwrap());
     assert_eq!(nulls.filter(|v| v.is_null()).count(), 9 - maps.feasible());
@@ -713,4 +713,191 @@ fn usage_errors_are_clap_errors_with_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     let out = run(&["--help"]);
     assert!(out.status.success());
+}
+
+// ---------------------------------------------------------------------------------------------
+// what a new user trips on
+
+#[test]
+fn an_absurd_grid_is_refused_with_exit_2_before_sweeping() {
+    let fx = Fixture::new();
+    let r = fx.path();
+    let started = std::time::Instant::now();
+    assert_fails(
+        &["sweep", "--robot", r, "--joint", "1", "--torque", "0.3,0.3", "--grid", "100000"],
+        2,
+        &["--grid 100000", "at most 1001 points per axis", "N²", "1e10 points"],
+    );
+    assert!(started.elapsed().as_secs() < 30, "refused at once, not after sweeping");
+    // The largest grid accepted is the documented one.
+    assert_fails(
+        &["sweep", "--robot", r, "--joint", "1", "--torque", "0.3,0.3", "--grid", "1002"],
+        2,
+        &["--grid 1002", "at most 1001"],
+    );
+    // Too few points: the library's check speaks, named by the option.
+    assert_fails(
+        &["sweep", "--robot", r, "--joint", "1", "--torque", "0.3,0.3", "--grid", "1"],
+        2,
+        &["--grid 1", "need at least 2"],
+    );
+}
+
+#[test]
+fn the_library_names_an_unknown_joint_for_the_command() {
+    let fx = Fixture::new();
+    let r = fx.path();
+    // The library's NoSuchJoint, prefixed by the option it came from.
+    assert_fails(
+        &["joint", "--robot", r, "--joint", "6", "--q", "0,0", "--torque", "0,0"],
+        2,
+        &["--joint 6: joint 6 does not exist", "5 universal joints"],
+    );
+    // A level outside [0, 1]: the library's InvalidLevel, exit 2.
+    let q = list(&E4_Q);
+    assert_fails(
+        &["arm", "--robot", r, "--q", &q, "--levels", "0,0,0,0,-0.5"],
+        2,
+        &["--levels: joint 5", "tension level -0.5", "[0, 1]"],
+    );
+    // An angle outside the limits: the library's OutOfLimits, numbers compact.
+    assert_fails(
+        &["joint", "--robot", r, "--joint", "2", "--q", "0,1", "--torque", "0,0"],
+        2,
+        &["--q: joint `joint2_y`", "angle 1 rad", "[-0.5236, 0.5236]"],
+    );
+}
+
+#[test]
+fn a_huge_infeasible_load_prints_compact_numbers_with_exit_1() {
+    let fx = Fixture::new();
+    let r = fx.path();
+    for args in [
+        vec!["joint", "--robot", r, "--joint", "1", "--q", "0,0", "--torque", "1e300,0"],
+        vec!["arm", "--robot", r, "--q", "0,0,0,0,0,0,0,0,0,0", "--wrench", "0,1e300,0,0,0,0"],
+    ] {
+        let out = run(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("sinew: infeasible load: joint"), "{args:?}: {stderr}");
+        assert!(
+            stderr.len() < 400,
+            "{args:?}: a short message, got {} bytes: {stderr}",
+            stderr.len()
+        );
+        let longest_number =
+            stderr.split(|c: char| !c.is_ascii_digit()).map(str::len).max().unwrap_or(0);
+        assert!(longest_number <= 6, "{args:?}: no long number: {stderr}");
+    }
+}
+
+#[test]
+fn joint_names_the_cables_it_counts_in_both_models() {
+    let fx = Fixture::new();
+    for (model, routing) in [("decoupled", &fx.routing), ("routed", &fx.routed)] {
+        let args = [
+            "joint",
+            "--robot",
+            fx.path(),
+            "--model",
+            model,
+            "--joint",
+            "1",
+            "--q",
+            "0.2,-0.1",
+            "--torque",
+            "0.3,0.3",
+        ];
+        let doc = json(&[&args[..], &["--json"]].concat());
+        let probe = JointProbe::new(&fx.robot, routing, 0).unwrap();
+        let name = |c: usize| routing.cables()[c].name.clone();
+        let own: Vec<String> = probe.tensioned_cables().map(name).collect();
+        let inherent: Vec<String> = probe.inherent_cables().iter().map(|&c| name(c)).collect();
+        assert_eq!(doc["cables"], serde_json::json!(own), "{model}");
+        assert_eq!(doc["inherent_cables"], serde_json::json!(inherent), "{model}");
+        // Every cable crossing joint 1 is counted, and only those.
+        let crossing: Vec<String> = routing
+            .cables()
+            .iter()
+            .filter(|c| c.dofs.start <= 1 && c.dofs.end > 0)
+            .map(|c| c.name.clone())
+            .collect();
+        assert_eq!(inherent, crossing, "{model}");
+        if model == "decoupled" {
+            assert_eq!(inherent, own, "decoupled: the joint's own cables only");
+        } else {
+            assert_eq!(
+                inherent.len(),
+                routing.cable_count(),
+                "routed: every cable crosses joint 1"
+            );
+        }
+        let text = String::from_utf8(run(&args).stdout).unwrap();
+        assert!(
+            text.contains(&format!("tension in {} only", own.join(", ")))
+                && text.contains(&format!("inherent stiffness of {}", inherent.join(", "))),
+            "{model}: the table says what it counts:\n{text}"
+        );
+    }
+}
+
+#[test]
+fn any_universal_joint_axes_load_and_are_named() {
+    // joint2_y turned to another unit axis: the second universal joint is no longer "x then y".
+    let with_second_axis = |axis: &str| {
+        let fx = Fixture::new();
+        let urdf = fx.dir.path().join("cdhrm5.urdf");
+        let text = std::fs::read_to_string(&urdf).unwrap();
+        let at = text.find("<joint name=\"joint2_y\"").unwrap();
+        let old = "<axis xyz=\"0 1 0\"/>";
+        let axis_at = at + text[at..].find(old).unwrap();
+        let mut edited = text.clone();
+        edited.replace_range(axis_at..axis_at + old.len(), &format!("<axis xyz=\"{axis}\"/>"));
+        std::fs::write(&urdf, edited).unwrap();
+        fx
+    };
+    // An oblique axis in the disc plane: loads, computes, and is named.
+    let fx = with_second_axis("0.6 0.8 0");
+    let robot = sinew::robot::load(fx.dir.path()).unwrap();
+    let routing = sinew::routing::load(fx.dir.path().join("cables.toml"), &robot).unwrap();
+    let args =
+        ["joint", "--robot", fx.path(), "--joint", "2", "--q", "0.1,-0.2", "--torque", "0.3,0.3"];
+    let doc = json(&[&args[..], &["--json"]].concat());
+    assert_eq!(doc["axes"][0]["name"], "joint2_x");
+    assert_vec(&doc["axes"][0]["axis"], &[1.0, 0.0, 0.0], "first axis");
+    assert_eq!(doc["axes"][1]["name"], "joint2_y");
+    assert_vec(&doc["axes"][1]["axis"], &[0.6, 0.8, 0.0], "second axis");
+    // The numbers are the library's for these axes.
+    let mut probe = JointProbe::new(&robot, &routing, 1).unwrap();
+    let range = probe.evaluate(&robot, &routing, [0.1, -0.2], [0.3, 0.3]).unwrap();
+    assert_m2(&doc["k"][0], &range.k_at_min, "k at min");
+    assert_m2(&doc["k"][1], &range.k_at_max, "k at max");
+    let table = String::from_utf8(run(&args).stdout).unwrap();
+    assert!(
+        table.contains("second `joint2_y` [0.600, 0.800, 0.000]"),
+        "the table names the second axis:\n{table}"
+    );
+    let sweep = json(&[
+        "sweep",
+        "--robot",
+        fx.path(),
+        "--joint",
+        "2",
+        "--torque",
+        "0.3,0.3",
+        "--grid",
+        "3",
+        "--json",
+    ]);
+    assert_vec(&sweep["axes"][1]["axis"], &[0.6, 0.8, 0.0], "sweep's second axis");
+    // x then z: loads and computes; cables along the arm cannot twist it about z, which is an
+    // answer (lost force closure, exit 1), not a load error.
+    let fx = with_second_axis("0 0 1");
+    let routing = json(&["routing", "--robot", fx.path(), "--json"]);
+    assert_vec(&routing["joints"][3]["axis"], &[0.0, 0.0, 1.0], "x then z loads");
+    assert_fails(
+        &["joint", "--robot", fx.path(), "--joint", "2", "--q", "0.1,-0.2", "--torque", "0.3,0.3"],
+        1,
+        &["infeasible load: joint 2", "force closure"],
+    );
 }

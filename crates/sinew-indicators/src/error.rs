@@ -1,6 +1,18 @@
 //! The one error type of this crate.
 
+use sinew_robot::{Compact, RobotError};
+use sinew_routing::RoutingError;
+use sinew_statics::StaticsError;
+use sinew_stiffness::StiffnessError;
+
 /// Everything that can go wrong computing an indicator.
+///
+/// **One path per underlying error.** The errors of the crates below nest (a
+/// `StiffnessError::Statics` carries a `StaticsError`, which may carry a `RoutingError`, which
+/// may carry a `RobotError`). The `From` conversions unwrap that nesting, so an error always
+/// arrives in the variant of the crate that raised it: a robot error (e.g. an angle outside
+/// the limits) is always [`IndicatorError::Robot`], an infeasible load always
+/// [`IndicatorError::Statics`], never a `Stiffness(Statics(..))`.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum IndicatorError {
@@ -12,6 +24,18 @@ pub enum IndicatorError {
         /// How many universal joints there are.
         joints: usize,
     },
+    /// The joint does not have exactly three cables of its own, consecutive in the routing:
+    /// the single-joint model (eq. 22–23) cannot take it.
+    #[error(
+        "joint {} has {cables} cables of its own; the single-joint model needs exactly three, consecutive in the routing",
+        .joint + 1
+    )]
+    NotThreeCables {
+        /// The joint (0-based).
+        joint: usize,
+        /// How many cables drive it.
+        cables: usize,
+    },
     /// A stiffness matrix with a NaN or infinite entry.
     #[error("{what} has a non-finite entry")]
     NonFinite {
@@ -19,39 +43,87 @@ pub enum IndicatorError {
         what: &'static str,
     },
     /// A zero or non-finite direction for a directional stiffness.
-    #[error("direction {direction:?} is not a non-zero finite vector")]
+    #[error(
+        "direction [{}, {}, {}] is not a non-zero finite vector",
+        Compact(.direction[0]), Compact(.direction[1]), Compact(.direction[2])
+    )]
     InvalidDirection {
         /// The direction passed.
         direction: [f64; 3],
     },
-    /// A sweep grid of fewer than 2 points per axis, or an empty or non-finite range.
-    #[error("invalid sweep grid: {reason}")]
-    InvalidGrid {
-        /// What is wrong.
-        reason: String,
+    /// A sweep grid of fewer than [`crate::AngleGrid::MIN_POINTS`] points per axis.
+    #[error("sweep grid of {points} points per axis: need at least {min}")]
+    GridTooSmall {
+        /// Points per axis asked for.
+        points: usize,
+        /// The least accepted.
+        min: usize,
     },
-    /// An infeasible tension interval or another statics error (boxed: it is large).
+    /// A sweep grid whose angle range is empty or not finite.
+    #[error(
+        "sweep grid range [{}, {}] rad is empty or not finite",
+        Compact(*.lower), Compact(*.upper)
+    )]
+    GridRange {
+        /// First angle, rad.
+        lower: f64,
+        /// Last angle, rad.
+        upper: f64,
+    },
+    /// A statics error (an infeasible tension interval among them), never one of its
+    /// wrapping variants (boxed: it is large).
     #[error(transparent)]
-    Statics(Box<sinew_statics::StaticsError>),
-    /// A stiffness error (boxed: it is large and rare).
+    Statics(Box<StaticsError>),
+    /// A stiffness error, never one of its wrapping variants (boxed: it is large and rare).
     #[error(transparent)]
-    Stiffness(Box<sinew_stiffness::StiffnessError>),
-    /// A cable geometry error.
+    Stiffness(Box<StiffnessError>),
+    /// A cable geometry error, never its `Robot` variant.
     #[error(transparent)]
-    Routing(#[from] sinew_routing::RoutingError),
+    Routing(RoutingError),
     /// A robot model error (e.g. angles outside the limits).
     #[error(transparent)]
-    Robot(#[from] sinew_robot::RobotError),
+    Robot(RobotError),
 }
 
-impl From<sinew_stiffness::StiffnessError> for IndicatorError {
-    fn from(e: sinew_stiffness::StiffnessError) -> Self {
-        IndicatorError::Stiffness(Box::new(e))
+impl IndicatorError {
+    /// Whether this is an infeasible load (the torque cannot be held within the limits).
+    pub fn is_infeasible(&self) -> bool {
+        matches!(self, IndicatorError::Statics(e) if matches!(**e, StaticsError::Infeasible { .. }))
     }
 }
 
-impl From<sinew_statics::StaticsError> for IndicatorError {
-    fn from(e: sinew_statics::StaticsError) -> Self {
-        IndicatorError::Statics(Box::new(e))
+impl From<RobotError> for IndicatorError {
+    fn from(e: RobotError) -> Self {
+        IndicatorError::Robot(e)
+    }
+}
+
+impl From<RoutingError> for IndicatorError {
+    fn from(e: RoutingError) -> Self {
+        match e {
+            RoutingError::Robot(e) => e.into(),
+            e => IndicatorError::Routing(e),
+        }
+    }
+}
+
+impl From<StaticsError> for IndicatorError {
+    fn from(e: StaticsError) -> Self {
+        match e {
+            StaticsError::Robot(e) => e.into(),
+            StaticsError::Routing(e) => e.into(),
+            e => IndicatorError::Statics(Box::new(e)),
+        }
+    }
+}
+
+impl From<StiffnessError> for IndicatorError {
+    fn from(e: StiffnessError) -> Self {
+        match e {
+            StiffnessError::Statics(e) => e.into(),
+            StiffnessError::Robot(e) => e.into(),
+            StiffnessError::Routing(e) => e.into(),
+            e => IndicatorError::Stiffness(Box::new(e)),
+        }
     }
 }

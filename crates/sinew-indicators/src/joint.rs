@@ -12,11 +12,23 @@
 //! σ_{i,x} = [K_{i,x}, Δk_{i,x}]ᵀ,  K_{i,x} ∈ [K^min, K^max],  Δk_{i,x} = K^max − K^min   (eq. 20)
 //! ```
 //!
-//! This is the paper's single-joint model: the joint with its own three cables, the other joints
-//! at the angles given (zero by default) and their cables slack. It is meant for the decoupled
-//! routing, where no other cable touches the joint; in the routed model the cables of distal
-//! joints cross it too, and the arm-level analysis (`sinew_stiffness::ArmStiffness`) is the
-//! one that accounts for them.
+//! This is the paper's single-joint model: the joint's own three cables hold the torque, the
+//! other joints are at the angles given (zero by default). Exactly what it counts:
+//!
+//! - **tension** (the controllable part `Σ f_c H_c`): the joint's own three cables only
+//!   ([`JointProbe::tensioned_cables`]); every other cable is at zero tension;
+//! - **inherent** part `J_cᵀ K_l J_c`: every cable crossing the joint
+//!   ([`JointProbe::inherent_cables`]), as elastic members at zero tension. In the decoupled
+//!   routing these are the same three cables; in the routed model the distal joints' cables
+//!   cross the joint too and add their inherent stiffness, but not their tension's (their
+//!   tensions come from the whole arm's statics: `sinew_stiffness::ArmStiffness` accounts for
+//!   them).
+//!
+//! The two angles, torque components and stiffness axes are about the universal joint's first
+//! and second revolute joints (`Q[2i]`, `Q[2i+1]`), whatever their URDF axes; the paper's
+//! `x` and `y` name the first and the second.
+
+use std::ops::Range;
 
 use faer::Mat;
 use nalgebra::{Matrix2, Matrix3x2, Vector2};
@@ -52,9 +64,11 @@ pub struct JointStiffnessRange {
     pub k_at_min: Matrix2<f64>,
     /// Joint stiffness at `λ_max` (most total tension), 2 × 2, N m/rad.
     pub k_at_max: Matrix2<f64>,
-    /// The controllable part at both ends (`Σ f_c H_c`), N m/rad.
+    /// The controllable part at both ends (`Σ f_c H_c` over the joint's own three cables,
+    /// [`JointProbe::tensioned_cables`]), N m/rad.
     pub controllable: [Matrix2<f64>; 2],
-    /// The inherent part (`J_cᵀ K_l J_c`, the same at both ends), N m/rad.
+    /// The inherent part (`J_cᵀ K_l J_c` over every cable crossing the joint,
+    /// [`JointProbe::inherent_cables`]; the same at both ends), N m/rad.
     pub inherent: Matrix2<f64>,
 }
 
@@ -82,6 +96,8 @@ pub struct JointProbe {
     joint: usize,
     /// Index of the first of the joint's three cables (cables are ordered by joint).
     first_cable: usize,
+    /// Every cable crossing the joint (its length depends on `Q[2i]` or `Q[2i+1]`).
+    crossing: Vec<usize>,
     limits: TensionLimits,
     q: Vec<f64>,
     tensions: Vec<f64>,
@@ -95,8 +111,8 @@ impl JointProbe {
     /// A probe of universal joint `joint` (0-based), the other joints at zero.
     ///
     /// # Errors
-    /// [`IndicatorError::NoSuchJoint`]; [`IndicatorError::Statics`] when the joint does not
-    /// have exactly three cables of its own.
+    /// [`IndicatorError::NoSuchJoint`]; [`IndicatorError::NotThreeCables`] when the joint does
+    /// not have exactly three cables of its own.
     pub fn new(
         robot: &Robot,
         routing: &Routing,
@@ -110,20 +126,21 @@ impl JointProbe {
             (0..routing.cable_count()).filter(|&c| routing.cable_joints()[c] == joint).collect();
         let first_cable = own.first().copied().unwrap_or(0);
         if own.len() != 3 || own[2] != first_cable + 2 {
-            return Err(sinew_statics::StaticsError::UnsupportedRouting {
-                reason: format!(
-                    "joint {} has {} cables; the single-joint model needs its own three",
-                    joint + 1,
-                    own.len()
-                ),
-            }
-            .into());
+            return Err(IndicatorError::NotThreeCables { joint, cables: own.len() });
         }
         let [f_min, f_max] = routing.tension_limits();
         let n = robot.dof();
+        let crossing = routing
+            .cables()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.dofs.contains(&(2 * joint)) || c.dofs.contains(&(2 * joint + 1)))
+            .map(|(k, _)| k)
+            .collect();
         Ok(JointProbe {
             joint,
             first_cable,
+            crossing,
             limits: TensionLimits { f_min, f_max },
             q: vec![0.0; n],
             tensions: vec![0.0; routing.cable_count()],
@@ -137,6 +154,19 @@ impl JointProbe {
     /// The probed joint (0-based).
     pub fn joint(&self) -> usize {
         self.joint
+    }
+
+    /// The cables with tension (indices in the routing): the joint's own three. Only they
+    /// enter the controllable part `Σ f_c H_c`; every other cable is at zero tension.
+    pub fn tensioned_cables(&self) -> Range<usize> {
+        self.first_cable..self.first_cable + 3
+    }
+
+    /// The cables whose inherent stiffness `J_cᵀ K_l J_c` is counted (indices in the routing,
+    /// ascending): every cable crossing the joint. The own three when decoupled; routed, also
+    /// the distal joints' cables.
+    pub fn inherent_cables(&self) -> &[usize] {
+        &self.crossing
     }
 
     /// Set the angles of the other joints (length dof; the probed joint's entries are

@@ -1,8 +1,9 @@
 //! Sweeps of a joint's stiffness indicators over a grid of its two angles (the paper's Fig. 5),
-//! in parallel over the grid (rayon), with a progress bar on a terminal (indicatif; silent
-//! when standard error is not a terminal).
+//! in parallel over the grid (rayon). Progress is reported to a callback; drawing it (a
+//! progress bar, a log line) is the caller's business.
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 use sinew_robot::Robot;
 use sinew_routing::Routing;
@@ -22,21 +23,23 @@ pub struct AngleGrid {
 }
 
 impl AngleGrid {
+    /// The least number of points per axis (the two ends of the range).
+    pub const MIN_POINTS: usize = 2;
+
     /// The `k`-th angle of the grid, rad.
     pub fn angle(&self, k: usize) -> f64 {
         self.lower + (self.upper - self.lower) * k as f64 / (self.points - 1) as f64
     }
 
     fn check(&self) -> Result<(), IndicatorError> {
-        if self.points < 2 {
-            return Err(IndicatorError::InvalidGrid {
-                reason: format!("{} points per axis; at least 2", self.points),
+        if self.points < Self::MIN_POINTS {
+            return Err(IndicatorError::GridTooSmall {
+                points: self.points,
+                min: Self::MIN_POINTS,
             });
         }
         if !(self.lower.is_finite() && self.upper.is_finite() && self.lower < self.upper) {
-            return Err(IndicatorError::InvalidGrid {
-                reason: format!("range [{}, {}] is empty or not finite", self.lower, self.upper),
-            });
+            return Err(IndicatorError::GridRange { lower: self.lower, upper: self.upper });
         }
         Ok(())
     }
@@ -79,12 +82,15 @@ impl SweepMaps {
 
 /// Sweep joint `joint`'s indicators over `grid × grid` for the torque `tau` (Fig. 5).
 ///
-/// Parallel over the grid's rows; each thread reuses one [`JointProbe`]. A progress bar is
-/// drawn on standard error when it is a terminal. Infeasible points are `None`; other errors
-/// (angles outside the limits, bad geometry) stop the sweep.
+/// Parallel over the grid's rows; each thread reuses one [`JointProbe`]. After each row,
+/// `progress(done, total)` is called with the number of points done so far and the total
+/// (`points²`), from whichever thread finished the row (pass `&|_, _| {}` for none).
+/// Infeasible points are `None`; other errors (angles outside the limits, bad geometry) stop
+/// the sweep.
 ///
 /// # Errors
-/// [`IndicatorError::InvalidGrid`], [`IndicatorError::NoSuchJoint`], and the first
+/// [`IndicatorError::GridTooSmall`], [`IndicatorError::GridRange`],
+/// [`IndicatorError::NoSuchJoint`], [`IndicatorError::NotThreeCables`], and the first
 /// non-infeasibility error of a point.
 pub fn sweep_joint(
     robot: &Robot,
@@ -92,17 +98,12 @@ pub fn sweep_joint(
     joint: usize,
     tau: [f64; 2],
     grid: AngleGrid,
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<SweepMaps, IndicatorError> {
     grid.check()?;
     let probe = JointProbe::new(robot, routing, joint)?;
     let n = grid.points;
-    let progress =
-        ProgressBar::with_draw_target(Some((n * n) as u64), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("sweep {bar:40} {pos}/{len} points ({eta} left)")
-    {
-        progress.set_style(style);
-    }
+    let done = AtomicUsize::new(0);
     let rows: Result<Vec<Vec<Option<SweepCell>>>, IndicatorError> = (0..n)
         .into_par_iter()
         .map_init(
@@ -113,20 +114,15 @@ pub fn sweep_joint(
                     let q = [grid.angle(a), grid.angle(b)];
                     let cell = match probe.evaluate(robot, routing, q, tau) {
                         Ok(range) => Some(SweepCell { k_x: range.sigma_x(), k_y: range.sigma_y() }),
-                        Err(IndicatorError::Statics(e))
-                            if matches!(*e, sinew_statics::StaticsError::Infeasible { .. }) =>
-                        {
-                            None
-                        }
+                        Err(e) if e.is_infeasible() => None,
                         Err(e) => return Err(e),
                     };
                     row.push(cell);
                 }
-                progress.inc(n as u64);
+                progress(done.fetch_add(n, Ordering::Relaxed) + n, n * n);
                 Ok(row)
             },
         )
         .collect();
-    progress.finish_and_clear();
     Ok(SweepMaps { joint, torque: tau, grid, cells: rows?.into_iter().flatten().collect() })
 }

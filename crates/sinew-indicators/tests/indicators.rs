@@ -60,7 +60,7 @@ fn e2_more_tension_more_stiffness() {
 fn sweep_cells_equal_single_evaluations_and_mark_infeasible_points() {
     let (robot, routing) = cdhrm5();
     let grid = AngleGrid { lower: -PI / 6.0, upper: PI / 6.0, points: 5 };
-    let maps = sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid).unwrap();
+    let maps = sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap();
     assert_eq!(maps.cells.len(), 25);
     let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
     for a in 0..5 {
@@ -73,7 +73,7 @@ fn sweep_cells_equal_single_evaluations_and_mark_infeasible_points() {
         }
     }
     // A torque no cable set can hold: every cell infeasible, no error.
-    let maps = sweep_joint(&robot, &routing, 0, [50.0, 0.0], grid).unwrap();
+    let maps = sweep_joint(&robot, &routing, 0, [50.0, 0.0], grid, &|_, _| {}).unwrap();
     assert_eq!(maps.feasible(), 0);
 }
 
@@ -92,9 +92,49 @@ fn bad_probes_and_grids_are_errors() {
     );
     let grid = AngleGrid { lower: 0.1, upper: 0.1, points: 3 };
     assert!(matches!(
-        sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid),
-        Err(IndicatorError::InvalidGrid { .. })
+        sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid, &|_, _| {}),
+        Err(IndicatorError::GridRange { .. })
     ));
+    let grid = AngleGrid { lower: -0.1, upper: 0.1, points: 1 };
+    assert!(matches!(
+        sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid, &|_, _| {}),
+        Err(IndicatorError::GridTooSmall { points: 1, min: 2 })
+    ));
+}
+
+#[test]
+fn sweep_reports_progress_up_to_the_total() {
+    use std::sync::Mutex;
+    let (robot, routing) = cdhrm5();
+    let grid = AngleGrid { lower: -0.2, upper: 0.2, points: 5 };
+    let seen = Mutex::new(Vec::new());
+    let record = |done: usize, total: usize| {
+        if let Ok(mut seen) = seen.lock() {
+            seen.push((done, total));
+        }
+    };
+    sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid, &record).unwrap();
+    let mut seen = seen.into_inner().unwrap();
+    seen.sort_unstable();
+    // One call per row, counting up to 25 points.
+    assert_eq!(seen, (1..=5).map(|r| (5 * r, 25)).collect::<Vec<_>>());
+}
+
+#[test]
+fn lower_errors_arrive_by_one_path() {
+    // An infeasible load is a statics error, never wrapped in a stiffness error.
+    let (robot, routing) = cdhrm5();
+    let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
+    let err = probe.evaluate(&robot, &routing, [0.0, 0.0], [1e300, 0.0]).unwrap_err();
+    assert!(err.is_infeasible(), "{err:?}");
+    let nested = sinew_stiffness::StiffnessError::Statics(sinew_statics::StaticsError::Robot(
+        sinew_robot::RobotError::NoJoints { source_name: "x".into() },
+    ));
+    assert!(matches!(IndicatorError::from(nested), IndicatorError::Robot(_)));
+    let nested = sinew_routing::RoutingError::Robot(sinew_robot::RobotError::NoJoints {
+        source_name: "x".into(),
+    });
+    assert!(matches!(IndicatorError::from(nested), IndicatorError::Robot(_)));
 }
 
 #[test]

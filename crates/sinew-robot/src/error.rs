@@ -2,10 +2,13 @@
 
 use std::path::PathBuf;
 
+use crate::Compact;
+
 /// Everything that can go wrong while loading a robot or evaluating it at a configuration.
 ///
 /// Every variant names the file, element or joint at fault, so that a message read on its own
-/// says what to fix.
+/// says what to fix; numbers print through [`Compact`] (at most 5 significant digits,
+/// scientific when huge or tiny).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum RobotError {
@@ -110,7 +113,8 @@ pub enum RobotError {
     },
     /// A revolute joint whose lower limit is not below its upper limit.
     #[error(
-        "{source_name}: joint `{joint}` has limits [{lower}, {upper}]; lower must be below upper"
+        "{source_name}: joint `{joint}` has limits [{}, {}]; lower must be below upper",
+        Compact(*.lower), Compact(*.upper)
     )]
     InvalidLimits {
         /// The file.
@@ -124,7 +128,8 @@ pub enum RobotError {
     },
     /// A link with a negative (or non-finite) mass.
     #[error(
-        "{source_name}: link `{link}` has mass {mass} kg; mass must be finite and non-negative"
+        "{source_name}: link `{link}` has mass {} kg; mass must be finite and non-negative",
+        Compact(*.mass)
     )]
     InvalidMass {
         /// The file.
@@ -159,7 +164,10 @@ pub enum RobotError {
         link: String,
     },
     /// The gravity vector in the description is not finite.
-    #[error("{path}: gravity {gravity:?} is not a finite vector")]
+    #[error(
+        "{path}: gravity [{}, {}, {}] is not a finite vector",
+        Compact(.gravity[0]), Compact(.gravity[1]), Compact(.gravity[2])
+    )]
     InvalidGravity {
         /// The description file.
         path: PathBuf,
@@ -177,7 +185,7 @@ pub enum RobotError {
         got: usize,
     },
     /// A joint angle is NaN or infinite.
-    #[error("joint `{joint}`: angle {value} is not finite")]
+    #[error("joint `{joint}`: angle {} is not finite", Compact(*.value))]
     NonFiniteAngle {
         /// The joint.
         joint: String,
@@ -185,7 +193,10 @@ pub enum RobotError {
         value: f64,
     },
     /// A joint angle outside its limits.
-    #[error("joint `{joint}`: angle {position} rad is outside its limits [{lower}, {upper}] rad")]
+    #[error(
+        "joint `{joint}`: angle {} rad is outside its limits [{}, {}] rad",
+        Compact(*.position), Compact(*.lower), Compact(*.upper)
+    )]
     OutOfLimits {
         /// The joint.
         joint: String,

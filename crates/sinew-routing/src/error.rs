@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use sinew_robot::RobotError;
+use sinew_robot::{Compact, RobotError};
 
 /// Everything that can go wrong while loading a routing or evaluating it at a configuration.
 ///
@@ -106,21 +106,22 @@ pub enum RoutingError {
     },
     /// A cable's `joint` is not a universal joint of the robot, or its anchor does not sit on
     /// the distal side of that joint, or none of its holes lies proximal to it.
-    #[error("{file}: cable `{cable}`: {field}: {message}")]
+    #[error("{file}: cable `{cable}`: {field}: {problem}")]
     WrongJoint {
         /// The routing file.
         file: String,
         /// The cable.
         cable: String,
-        /// The field at fault (`cable[i].joint` or the anchor's link).
+        /// The field at fault (`cable[i].joint`, the anchor's link or `cable[i].holes`).
         field: String,
         /// What is wrong, with the numbers.
-        message: String,
+        problem: JointProblem,
     },
     /// A segment between two consecutive holes has (near-)zero or non-finite length at Q = 0:
     /// its direction, and so its derivatives, would be undefined.
     #[error(
-        "{file}: cable `{cable}`: segment {segment} ({from} → {to}) has length {length} m at Q = 0; need a finite length ≥ {min} m"
+        "{file}: cable `{cable}`: segment {segment} ({from} → {to}) has length {} m at Q = 0; need a finite length ≥ {} m",
+        Compact(*.length), Compact(*.min)
     )]
     ZeroLengthSegment {
         /// The routing file.
@@ -140,7 +141,7 @@ pub enum RoutingError {
     },
     /// The cable material is not physical: a non-positive or non-finite Young's modulus,
     /// diameter or area (or neither/both of diameter and area). It applies to every cable.
-    #[error("{file}: {field} = {value}: {message} (applies to every cable)")]
+    #[error("{file}: {field} = {}: {message} (applies to every cable)", Compact(*.value))]
     InvalidMaterial {
         /// The routing file.
         file: String,
@@ -153,7 +154,8 @@ pub enum RoutingError {
     },
     /// The tension limits `[f_min, f_max]` do not satisfy `0 ≤ f_min < f_max` (finite).
     #[error(
-        "{file}: tension_limits = [{f_min}, {f_max}] N: need finite 0 ≤ f_min < f_max (applies to every cable)"
+        "{file}: tension_limits = [{}, {}] N: need finite 0 ≤ f_min < f_max (applies to every cable)",
+        Compact(*.f_min), Compact(*.f_max)
     )]
     InvalidTensionLimits {
         /// The routing file.
@@ -165,7 +167,7 @@ pub enum RoutingError {
     },
     /// A number in the file is out of its range (a NaN coordinate, a negative free length, a
     /// zero radius …). `cable` is empty when the field is not a cable's own.
-    #[error("{file}: {}{field} = {value}: {expected}", cable_prefix(.cable))]
+    #[error("{file}: {}{field} = {}: {expected}", cable_prefix(.cable), Compact(*.value))]
     InvalidValue {
         /// The routing file.
         file: String,
@@ -194,7 +196,8 @@ pub enum RoutingError {
     /// At a configuration, a segment became (nearly) zero-length: the cable's direction there is
     /// undefined. Never a NaN: this error instead.
     #[error(
-        "cable `{cable}`: segment {segment} has length {length} m at this configuration (< {min} m); its direction is undefined"
+        "cable `{cable}`: segment {segment} has length {} m at this configuration (< {} m); its direction is undefined",
+        Compact(*.length), Compact(*.min)
     )]
     DegenerateSegment {
         /// The cable.
@@ -266,6 +269,59 @@ pub enum RoutingError {
     /// An error of the robot model (kinematics, workspace, configuration).
     #[error(transparent)]
     Robot(#[from] RobotError),
+}
+
+/// Why a cable does not fit the joint it drives ([`RoutingError::WrongJoint`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum JointProblem {
+    /// The cable's `joint` is not a universal joint of the robot (0-based, as in the file).
+    NoSuchJoint {
+        /// The joint named.
+        joint: usize,
+        /// How many universal joints the robot has.
+        joints: usize,
+    },
+    /// The anchor (last hole) is not on a body that the driven joint moves and no further
+    /// joint does (bodies `2·joint + 1` and `2·joint + 2`).
+    AnchorElsewhere {
+        /// The joint driven (0-based).
+        joint: usize,
+        /// The anchor's body.
+        anchor_body: usize,
+    },
+    /// The anchor is on the base body: the cable drives no joint.
+    AnchorOnBase,
+    /// No hole lies proximal to the driven joint (on a body ≤ `2·joint`).
+    NotCrossing {
+        /// The joint driven (0-based).
+        joint: usize,
+    },
+}
+
+impl std::fmt::Display for JointProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            JointProblem::NoSuchJoint { joint, joints } => write!(
+                f,
+                "joint {joint} does not exist: the robot has universal joints 0..{joints}"
+            ),
+            JointProblem::AnchorElsewhere { joint, anchor_body } => write!(
+                f,
+                "the anchor is on body {anchor_body}, but a cable driving joint {joint} must end on body {} or {} (moved by joint {joint} and no further joint)",
+                2 * joint + 1,
+                2 * joint + 2
+            ),
+            JointProblem::AnchorOnBase => {
+                f.write_str("the anchor is on the base body: the cable drives no joint")
+            }
+            JointProblem::NotCrossing { joint } => write!(
+                f,
+                "no hole lies proximal to joint {joint} (on a body ≤ {}): the cable does not cross the joint it drives",
+                2 * joint
+            ),
+        }
+    }
 }
 
 fn cable_prefix(cable: &str) -> String {

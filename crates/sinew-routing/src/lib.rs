@@ -48,7 +48,7 @@ mod geometry;
 mod routing;
 pub mod spec;
 
-pub use error::{Result, RoutingError};
+pub use error::{JointProblem, Result, RoutingError};
 pub use geometry::{
     Order, RoutingData, SegmentHessians, compute_cable_geometry,
     compute_cable_geometry_from_kinematics,

@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 use sinew_robot::{BodyPoint, Robot, RobotData};
 
-use crate::error::{Result, RoutingError};
+use crate::error::{JointProblem, Result, RoutingError};
 use crate::spec::{PatternModel, PerJoint, RoutingSpec};
 
 /// The name of the routing file inside a robot folder.
@@ -658,39 +658,29 @@ fn check_cable(
     // At least two holes: checked above.
     let anchor = holes.last().map_or(0, |h| h.body_point.body);
     let anchor_field = cable.holes.last().map(|h| h.2.clone()).unwrap_or_default();
-    let wrong = |field: String, message: String| RoutingError::WrongJoint {
+    let wrong = |field: String, problem: JointProblem| RoutingError::WrongJoint {
         file: file.to_owned(),
         cable: name.clone(),
         field,
-        message,
+        problem,
     };
     let joint = match cable.joint {
         Some(j) => {
             let field = format!("{}.joint", cable.field);
             if j >= n {
-                return Err(wrong(
-                    field,
-                    format!("joint {j} does not exist: the robot has universal joints 0..{n}"),
-                ));
+                return Err(wrong(field, JointProblem::NoSuchJoint { joint: j, joints: n }));
             }
             if anchor == 0 || (anchor - 1) / 2 != j {
                 return Err(wrong(
                     anchor_field,
-                    format!(
-                        "the anchor is on body {anchor}, but a cable driving joint {j} must end on body {} or {} (moved by joint {j} and no further joint)",
-                        2 * j + 1,
-                        2 * j + 2
-                    ),
+                    JointProblem::AnchorElsewhere { joint: j, anchor_body: anchor },
                 ));
             }
             j
         }
         None => {
             if anchor == 0 {
-                return Err(wrong(
-                    anchor_field,
-                    "the anchor is on the base body: the cable drives no joint".to_owned(),
-                ));
+                return Err(wrong(anchor_field, JointProblem::AnchorOnBase));
             }
             (anchor - 1) / 2
         }
@@ -709,13 +699,7 @@ fn check_cable(
     }
     let proximal = holes.iter().map(|h| h.body_point.body).min().unwrap_or(anchor);
     if proximal > 2 * joint {
-        return Err(wrong(
-            format!("{}.holes", cable.field),
-            format!(
-                "no hole lies proximal to joint {joint} (on a body ≤ {}): the cable does not cross the joint it drives",
-                2 * joint
-            ),
-        ));
+        return Err(wrong(format!("{}.holes", cable.field), JointProblem::NotCrossing { joint }));
     }
     let free_length = match &cable.free_length {
         Some((v, field)) => {

@@ -6,7 +6,9 @@ mod common;
 
 use proptest::prelude::*;
 use sinew_robot::{ChainSettings, Robot, RobotData};
-use sinew_routing::{Order, Routing, RoutingData, RoutingError, compute_cable_geometry};
+use sinew_routing::{
+    JointProblem, Order, Routing, RoutingData, RoutingError, compute_cable_geometry,
+};
 
 const FILE: &str = "test/cables.toml";
 
@@ -214,23 +216,47 @@ fn wrong_joint() {
     // A joint the robot does not have.
     let text = explicit(&GOOD_CABLE.replace("name = \"good\"", "name = \"good\"\njoint = 7"));
     let err = error(&text, &["good", "cable[0].joint", "joint 7"]);
-    assert!(matches!(err, RoutingError::WrongJoint { .. }), "{err:?}");
+    assert!(
+        matches!(
+            err,
+            RoutingError::WrongJoint { problem: JointProblem::NoSuchJoint { joint: 7, .. }, .. }
+        ),
+        "{err:?}"
+    );
     // A joint other than the one the anchor's body is moved by.
     let text = explicit(&GOOD_CABLE.replace("name = \"good\"", "name = \"good\"\njoint = 0"));
     let err = error(&text, &["good", "cable[0].holes[3].link"]);
-    assert!(matches!(err, RoutingError::WrongJoint { .. }), "{err:?}");
+    assert!(
+        matches!(
+            err,
+            RoutingError::WrongJoint {
+                problem: JointProblem::AnchorElsewhere { joint: 0, .. },
+                ..
+            }
+        ),
+        "{err:?}"
+    );
     // Anchored on the base.
     let text = explicit(
         "[[cable]]\nname = \"flat\"\nholes = [{ link = \"base_link\", point = [0.0, 0.0, 0.0] }, { link = \"base_link\", point = [0.02, 0.0, 0.0] }]\n",
     );
     let err = error(&text, &["flat", "cable[0].holes[1].link", "base body"]);
-    assert!(matches!(err, RoutingError::WrongJoint { .. }), "{err:?}");
+    assert!(
+        matches!(err, RoutingError::WrongJoint { problem: JointProblem::AnchorOnBase, .. }),
+        "{err:?}"
+    );
     // Not crossing its joint: both holes beyond joint 0's proximal disc, anchored on link1.
     let text = explicit(
         "[[cable]]\nname = \"inside\"\nholes = [{ link = \"cross1\", point = [0.0, 0.0, 0.0] }, { link = \"link1\", point = [0.02, 0.0, 0.0] }]\n",
     );
     let err = error(&text, &["inside", "cable[0].holes", "does not cross"]);
-    assert!(matches!(err, RoutingError::WrongJoint { .. }), "{err:?}");
+    assert!(
+        matches!(
+            err,
+            RoutingError::WrongJoint { problem: JointProblem::NotCrossing { joint: 0 }, .. }
+        ),
+        "{err:?}"
+    );
 }
 
 #[test]

@@ -1,5 +1,7 @@
 //! The one error type of this crate.
 
+use sinew_robot::Compact;
+
 /// Why a joint's cables cannot hold its torque.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -29,12 +31,16 @@ impl std::fmt::Display for InfeasibleReason {
             InfeasibleReason::RankDeficient => write!(f, "its cable Jacobian has rank < 2"),
             InfeasibleReason::NoForceClosure { null } => write!(
                 f,
-                "its cables have lost force closure (null direction [{:.3}, {:.3}, {:.3}] is not positive)",
-                null[0], null[1], null[2]
+                "its cables have lost force closure (null direction [{}, {}, {}] is not positive)",
+                Compact(null[0]),
+                Compact(null[1]),
+                Compact(null[2])
             ),
             InfeasibleReason::OutsideLimits { lambda_min, lambda_max } => write!(
                 f,
-                "no tensions within the limits hold the torque (λ ≥ {lambda_min:.4} and λ ≤ {lambda_max:.4})"
+                "no tensions within the limits hold the torque (λ ≥ {} and λ ≤ {})",
+                Compact(*lambda_min),
+                Compact(*lambda_max)
             ),
         }
     }
@@ -46,7 +52,7 @@ impl std::fmt::Display for InfeasibleReason {
 pub enum StaticsError {
     /// A joint's cables cannot hold its torque within the tension limits: the typed outcome of
     /// an infeasible load.
-    #[error("joint {} cannot hold torque [{:.4}, {:.4}] N m with tensions in [{}, {}] N: {reason}", .joint + 1, .torque[0], .torque[1], .limits[0], .limits[1])]
+    #[error("joint {} cannot hold torque [{}, {}] N m with tensions in [{}, {}] N: {reason}", .joint + 1, Compact(.torque[0]), Compact(.torque[1]), Compact(.limits[0]), Compact(.limits[1]))]
     Infeasible {
         /// Universal joint index (0-based; the message counts from 1, as the paper does).
         joint: usize,
