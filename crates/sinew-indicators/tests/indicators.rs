@@ -32,6 +32,7 @@ fn the_indicator_is_affine_in_the_tension_level() {
     let mut rdata = RobotData::new(&robot);
     let mut g = RoutingData::new(&routing);
     compute_cable_geometry(&routing, &robot, &mut rdata, &mut g, &full, Order::Hessians).unwrap();
+    let mut ends = [nalgebra::Matrix2::zeros(); 2];
     for s in [0.0, 0.3, 0.7, 1.0] {
         let f = range.interval.tensions_at_level(s);
         let mut tensions = vec![0.0; 15];
@@ -40,9 +41,15 @@ fn the_indicator_is_affine_in_the_tension_level() {
         joint_stiffness(&routing, &g, &tensions, kc.as_mut(), ki.as_mut()).unwrap();
         let direct = joint_block((&kc + &ki).as_ref(), 0).unwrap();
         assert_relative_eq!(range.at_level(s), direct, max_relative = 1e-12);
+        if s == 0.0 || s == 1.0 {
+            ends[s as usize] = direct;
+        }
     }
-    let sx = range.sigma_x();
-    assert_relative_eq!(sx.delta, sx.range[1] - sx.range[0]);
+    // σ's width (eq. 20) against |K(λ_max) − K(λ_min)| from the two direct evaluations.
+    let (sx, sy) = (range.sigma_x(), range.sigma_y());
+    assert_relative_eq!(sx.delta, (ends[1] - ends[0])[(0, 0)].abs(), max_relative = 1e-12);
+    assert_relative_eq!(sy.delta, (ends[1] - ends[0])[(1, 1)].abs(), max_relative = 1e-12);
+    assert!(sx.delta > 0.1 && sy.delta > 0.1, "E2's segment widens both: {sx:?} {sy:?}");
 }
 
 #[test]
