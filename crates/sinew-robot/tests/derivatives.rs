@@ -1,18 +1,23 @@
 //! Every analytic derivative against central finite differences, at 100 seeded random
 //! configurations within the limits, on cdhrm5 and a generated 50-joint (100-DOF) chain.
 //!
-//! Criterion: `max |analytic − numeric| ≤ 1e-6 · max(1, max |analytic|)` (see `common::rel_err`).
+//! Criterion: `max |analytic − numeric| ≤ 1e-6 · max(1, max |analytic|)` (`sinew_testkit::numeric::rel_err`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
-
-use common::{H, RTOL, rel_err};
 use faer::Mat;
 use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use sinew_robot::{BodyPoint, Robot, RobotData};
+use sinew_testkit::cdhrm5;
+use sinew_testkit::config::{random_q, rng};
+use sinew_testkit::numeric::{H, RTOL, central_difference, column, perturbed, rel_err};
 
 const CONFIGURATIONS: usize = 100;
+
+/// The robots the derivative tests run on: cdhrm5 and a generated 50-joint chain.
+fn test_robots() -> Vec<(&'static str, Robot)> {
+    vec![("cdhrm5", cdhrm5::robot()), ("uniform50", cdhrm5::chain_robot(50))]
+}
 
 /// A random point within 5 cm of a random moving body's origin.
 fn random_point(robot: &Robot, rng: &mut rand_chacha::ChaCha8Rng) -> BodyPoint {
@@ -30,13 +35,13 @@ fn jacobian_at(robot: &Robot, data: &mut RobotData, q: &[f64], p: &BodyPoint) ->
 
 #[test]
 fn point_jacobian_matches_finite_differences_of_the_pose() {
-    for (name, robot) in common::test_robots() {
+    for (name, robot) in test_robots() {
         let n = robot.dof();
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(11);
+        let mut rng = rng(11);
         let mut worst: f64 = 0.0;
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             let p = if rng.random_bool(0.5) {
                 robot.tip_point()
             } else {
@@ -45,10 +50,7 @@ fn point_jacobian_matches_finite_differences_of_the_pose() {
             let analytic = jacobian_at(&robot, &mut data, &q, &p);
             let mut numeric = Mat::zeros(6, n);
             for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += H;
-                qm[i] -= H;
+                let (qp, qm) = perturbed(&q, i, H);
                 robot.forward_kinematics(&mut data, &qp).unwrap();
                 let xp = robot.point_position(&data, &p).unwrap();
                 let rp = data.body_pose(p.body).unwrap().rotation;
@@ -78,14 +80,14 @@ fn point_jacobian_matches_finite_differences_of_the_pose() {
 
 #[test]
 fn jacobian_derivative_matches_finite_differences_of_the_jacobian() {
-    for (name, robot) in common::test_robots() {
+    for (name, robot) in test_robots() {
         let n = robot.dof();
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(12);
+        let mut rng = rng(12);
         let mut worst: f64 = 0.0;
         let mut analytic = Mat::zeros(6, n);
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             let p = if rng.random_bool(0.5) {
                 robot.tip_point()
             } else {
@@ -94,10 +96,7 @@ fn jacobian_derivative_matches_finite_differences_of_the_jacobian() {
             for i in 0..n {
                 robot.forward_kinematics(&mut data, &q).unwrap();
                 robot.point_jacobian_derivative(&data, &p, i, analytic.as_mut()).unwrap();
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += H;
-                qm[i] -= H;
+                let (qp, qm) = perturbed(&q, i, H);
                 let jp = jacobian_at(&robot, &mut data, &qp, &p);
                 let jm = jacobian_at(&robot, &mut data, &qm, &p);
                 let numeric = (jp - jm) * faer::Scale(1.0 / (2.0 * H));
@@ -123,14 +122,14 @@ fn generalized_force(
 
 #[test]
 fn wrench_torque_derivative_matches_finite_differences() {
-    for (name, robot) in common::test_robots() {
+    for (name, robot) in test_robots() {
         let n = robot.dof();
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(13);
+        let mut rng = rng(13);
         let mut worst: f64 = 0.0;
         let mut analytic = Mat::zeros(n, n);
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             let p = if rng.random_bool(0.5) {
                 robot.tip_point()
             } else {
@@ -139,18 +138,8 @@ fn wrench_torque_derivative_matches_finite_differences() {
             let f = Vector6::from_fn(|_, _| rng.random_range(-10.0..10.0));
             robot.forward_kinematics(&mut data, &q).unwrap();
             robot.wrench_torque_derivative(&mut data, &p, &f, analytic.as_mut()).unwrap();
-            let mut numeric = Mat::zeros(n, n);
-            for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += H;
-                qm[i] -= H;
-                let tp = generalized_force(&robot, &mut data, &qp, &p, &f);
-                let tm = generalized_force(&robot, &mut data, &qm, &p, &f);
-                for j in 0..n {
-                    numeric[(j, i)] = (tp[j] - tm[j]) / (2.0 * H);
-                }
-            }
+            let numeric =
+                central_difference(&q, H, |q| generalized_force(&robot, &mut data, q, &p, &f));
             worst = worst.max(rel_err(analytic.as_ref(), numeric.as_ref()));
         }
         println!("{name}: ∂(JᵀF)/∂Q worst relative error {worst:.2e}");
@@ -183,29 +172,17 @@ fn gravity_torque(robot: &Robot, data: &mut RobotData, q: &[f64]) -> Vec<f64> {
 
 #[test]
 fn gravity_torque_is_the_gradient_of_the_potential_energy() {
-    for (name, robot) in common::test_robots() {
-        let n = robot.dof();
+    for (name, robot) in test_robots() {
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(14);
+        let mut rng = rng(14);
         let mut worst: f64 = 0.0;
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             let analytic = gravity_torque(&robot, &mut data, &q);
-            let numeric: Vec<f64> = (0..n)
-                .map(|i| {
-                    let mut qp = q.clone();
-                    let mut qm = q.clone();
-                    qp[i] += H;
-                    qm[i] -= H;
-                    (potential_energy(&robot, &mut data, &qp)
-                        - potential_energy(&robot, &mut data, &qm))
-                        / (2.0 * H)
-                })
-                .collect();
-            worst = worst.max(rel_err(
-                common::column(&analytic).as_ref(),
-                common::column(&numeric).as_ref(),
-            ));
+            // The gradient as a 1 × n row: its transpose is the column of `T_g`.
+            let numeric =
+                central_difference(&q, H, |q| vec![potential_energy(&robot, &mut data, q)]);
+            worst = worst.max(rel_err(column(&analytic).as_ref(), numeric.transpose()));
         }
         println!("{name}: T_g worst relative error {worst:.2e}");
         assert!(worst <= RTOL, "{name}: T_g error {worst:e} > {RTOL:e}");
@@ -214,28 +191,17 @@ fn gravity_torque_is_the_gradient_of_the_potential_energy() {
 
 #[test]
 fn gravity_torque_derivative_matches_finite_differences_and_is_symmetric() {
-    for (name, robot) in common::test_robots() {
+    for (name, robot) in test_robots() {
         let n = robot.dof();
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(15);
+        let mut rng = rng(15);
         let mut worst: f64 = 0.0;
         let mut analytic = Mat::zeros(n, n);
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             robot.forward_kinematics(&mut data, &q).unwrap();
             robot.gravity_torque_derivative(&mut data, analytic.as_mut()).unwrap();
-            let mut numeric = Mat::zeros(n, n);
-            for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += H;
-                qm[i] -= H;
-                let tp = gravity_torque(&robot, &mut data, &qp);
-                let tm = gravity_torque(&robot, &mut data, &qm);
-                for j in 0..n {
-                    numeric[(j, i)] = (tp[j] - tm[j]) / (2.0 * H);
-                }
-            }
+            let numeric = central_difference(&q, H, |q| gravity_torque(&robot, &mut data, q));
             worst = worst.max(rel_err(analytic.as_ref(), numeric.as_ref()));
             let transpose = analytic.transpose().to_owned();
             assert!(
@@ -250,17 +216,17 @@ fn gravity_torque_derivative_matches_finite_differences_and_is_symmetric() {
 
 #[test]
 fn wrench_torque_is_jacobian_transpose_times_wrench() {
-    for (name, robot) in common::test_robots() {
+    for (name, robot) in test_robots() {
         let mut data = RobotData::new(&robot);
-        let mut rng = common::rng(16);
+        let mut rng = rng(16);
         let mut out = vec![0.0; robot.dof()];
         for _ in 0..CONFIGURATIONS {
-            let q = common::random_q(&robot, &mut rng);
+            let q = random_q(&robot, &mut rng);
             let p = random_point(&robot, &mut rng);
             let f = Vector6::from_fn(|_, _| rng.random_range(-10.0..10.0));
             let expected = generalized_force(&robot, &mut data, &q, &p, &f);
             robot.wrench_torque(&data, &p, &f, &mut out).unwrap();
-            let err = rel_err(common::column(&out).as_ref(), common::column(&expected).as_ref());
+            let err = rel_err(column(&out).as_ref(), column(&expected).as_ref());
             assert!(err <= 1e-12, "{name}: JᵀF error {err:e}");
         }
     }
