@@ -7,9 +7,8 @@
 use sinew::paper::PAPER_TABLE_2 as PAPER;
 
 fn ours() -> Vec<[[f64; 2]; 2]> {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
-    let robot = sinew::robot::load(dir).unwrap();
-    let routing = sinew::routing::load(dir, &robot).unwrap();
+    let (robot, routing) =
+        sinew_testkit::cdhrm5::robot_and_routing(sinew::routing::PatternModel::Decoupled);
     sinew::paper::table_2(&robot, &routing).unwrap().into_iter().map(|row| row.ours).collect()
 }
 

@@ -12,10 +12,7 @@ fn root() -> PathBuf {
 }
 
 fn cdhrm5() -> (sinew::robot::Robot, sinew::routing::Routing) {
-    let dir = root().join("robots/cdhrm5");
-    let robot = sinew::robot::load(&dir).unwrap();
-    let routing = sinew::routing::load(&dir, &robot).unwrap();
-    (robot, routing)
+    sinew_testkit::cdhrm5::robot_and_routing(sinew::routing::PatternModel::Decoupled)
 }
 
 /// The committed file must equal what the report writes now.
@@ -82,8 +79,7 @@ fn snapshots_are_identical_across_runs() {
 #[test]
 fn fig_6_e4_decoupled_and_routed() {
     let (robot, routing) = cdhrm5();
-    let routed =
-        sinew::routing::load(root().join("robots/cdhrm5/cables-routed.toml"), &robot).unwrap();
+    let routed = sinew_testkit::cdhrm5::routing(&robot, sinew::routing::PatternModel::Routed);
     let decoupled = paper::e4(&robot, &routing, "decoupled", 0.0).unwrap();
     let routed = paper::e4(&robot, &routed, "routed", 0.0).unwrap();
     let baseline = paper::e4(&robot, &routing, "decoupled", 0.25).unwrap();
