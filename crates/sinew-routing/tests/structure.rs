@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use faer::Mat;
-use sinew_robot::{RobotData, UniformChain};
+use sinew_robot::{Robot, RobotData, UniformChain};
 use sinew_routing::{
     Order, PatternModel, PerJoint, Routing, RoutingData, RoutingError, RoutingModel,
     compute_cable_geometry, compute_cable_geometry_from_kinematics,
@@ -34,88 +34,96 @@ fn cables_are_ordered_by_joint_three_each() {
     }
 }
 
-#[test]
-fn decoupled_jacobian_is_block_diagonal() {
+/// `check(name, robot, routing, data)` at 100 random configurations (seeded with `seed`) of
+/// every case of `model`, after the geometry with Hessians.
+fn at_random_configurations(
+    model: RoutingModel,
+    seed: u64,
+    mut check: impl FnMut(&str, &Robot, &Routing, &RoutingData),
+) {
     for (name, robot, routing) in cdhrm5::cases(50) {
-        if routing.model() != RoutingModel::Decoupled {
+        if routing.model() != model {
             continue;
         }
         let mut rdata = RobotData::new(&robot);
         let mut data = RoutingData::new(&routing);
-        let mut h = Mat::<f64>::zeros(robot.dof(), robot.dof());
-        let mut rng = rng(21);
+        let mut rng = rng(seed);
         for _ in 0..100 {
             let q = random_q(&robot, &mut rng);
             compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Hessians)
                 .unwrap();
-            let jacobian = data.jacobian().unwrap();
-            for (c, cable) in routing.cables().iter().enumerate() {
-                let own = 2 * cable.joint..2 * cable.joint + 2;
-                assert_eq!(cable.dofs, own, "{name}: {}", cable.name);
-                for k in 0..robot.dof() {
-                    if own.contains(&k) {
-                        continue;
-                    }
-                    assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
-                }
-                let arm = jacobian[(c, own.start)].abs() + jacobian[(c, own.start + 1)].abs();
-                assert!(arm > NONZERO, "{name}: {} has no moment arm on its joint", cable.name);
-                data.cable_hessian(&routing, c, h.as_mut()).unwrap();
-                for i in 0..robot.dof() {
-                    for k in 0..robot.dof() {
-                        if !(own.contains(&i) && own.contains(&k)) {
-                            assert_eq!(h[(i, k)], 0.0, "{name}: H of {} at ({i}, {k})", cable.name);
-                        }
-                    }
-                }
+            check(&name, &robot, &routing, &data);
+        }
+    }
+}
+
+/// The Hessian of cable `c` is exactly zero at every `(i, k)` where `zero(i, k)`.
+fn assert_hessian_zero_where(
+    name: &str,
+    routing: &Routing,
+    data: &RoutingData,
+    c: usize,
+    zero: impl Fn(usize, usize) -> bool,
+) {
+    let n = data.jacobian().unwrap().ncols();
+    let mut h = Mat::<f64>::zeros(n, n);
+    data.cable_hessian(routing, c, h.as_mut()).unwrap();
+    let cable = &routing.cables()[c].name;
+    for i in 0..n {
+        for k in 0..n {
+            if zero(i, k) {
+                assert_eq!(h[(i, k)], 0.0, "{name}: H of {cable} at ({i}, {k})");
             }
         }
     }
 }
 
 #[test]
-fn routed_jacobian_is_block_lower_triangular_with_proximal_blocks() {
-    for (name, robot, routing) in cdhrm5::cases(50) {
-        if routing.model() != RoutingModel::Routed {
-            continue;
-        }
-        let mut rdata = RobotData::new(&robot);
-        let mut data = RoutingData::new(&routing);
-        let mut h = Mat::<f64>::zeros(robot.dof(), robot.dof());
-        let mut rng = rng(22);
-        for _ in 0..100 {
-            let q = random_q(&robot, &mut rng);
-            compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Hessians)
-                .unwrap();
-            let jacobian = data.jacobian().unwrap();
-            for (c, cable) in routing.cables().iter().enumerate() {
-                let j = cable.joint;
-                assert_eq!(cable.dofs, 0..2 * j + 2, "{name}: {}", cable.name);
-                for k in 2 * j + 2..robot.dof() {
-                    assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
+fn decoupled_jacobian_is_block_diagonal() {
+    at_random_configurations(RoutingModel::Decoupled, 21, |name, robot, routing, data| {
+        let jacobian = data.jacobian().unwrap();
+        for (c, cable) in routing.cables().iter().enumerate() {
+            let own = 2 * cable.joint..2 * cable.joint + 2;
+            assert_eq!(cable.dofs, own, "{name}: {}", cable.name);
+            for k in 0..robot.dof() {
+                if own.contains(&k) {
+                    continue;
                 }
-                // Every joint up to its own carries it: non-zero blocks, proximal ones included.
-                for p in 0..=j {
-                    let arm = jacobian[(c, 2 * p)].abs() + jacobian[(c, 2 * p + 1)].abs();
-                    assert!(
-                        arm > NONZERO,
-                        "{name}: {} has no moment arm on joint {p} ({arm:.2e})",
-                        cable.name
-                    );
-                }
-                // Each segment crosses one universal joint: H_c is block diagonal in 2 × 2
-                // blocks over the joints 0..=j.
-                data.cable_hessian(&routing, c, h.as_mut()).unwrap();
-                for i in 0..robot.dof() {
-                    for k in 0..robot.dof() {
-                        if i / 2 != k / 2 || i / 2 > j {
-                            assert_eq!(h[(i, k)], 0.0, "{name}: H of {} at ({i}, {k})", cable.name);
-                        }
-                    }
-                }
+                assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
             }
+            let arm = jacobian[(c, own.start)].abs() + jacobian[(c, own.start + 1)].abs();
+            assert!(arm > NONZERO, "{name}: {} has no moment arm on its joint", cable.name);
+            assert_hessian_zero_where(name, routing, data, c, |i, k| {
+                !(own.contains(&i) && own.contains(&k))
+            });
         }
-    }
+    });
+}
+
+#[test]
+fn routed_jacobian_is_block_lower_triangular_with_proximal_blocks() {
+    at_random_configurations(RoutingModel::Routed, 22, |name, robot, routing, data| {
+        let jacobian = data.jacobian().unwrap();
+        for (c, cable) in routing.cables().iter().enumerate() {
+            let j = cable.joint;
+            assert_eq!(cable.dofs, 0..2 * j + 2, "{name}: {}", cable.name);
+            for k in 2 * j + 2..robot.dof() {
+                assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
+            }
+            // Every joint up to its own carries it: non-zero blocks, proximal ones included.
+            for p in 0..=j {
+                let arm = jacobian[(c, 2 * p)].abs() + jacobian[(c, 2 * p + 1)].abs();
+                assert!(
+                    arm > NONZERO,
+                    "{name}: {} has no moment arm on joint {p} ({arm:.2e})",
+                    cable.name
+                );
+            }
+            // Each segment crosses one universal joint: H_c is block diagonal in 2 × 2
+            // blocks over the joints 0..=j.
+            assert_hessian_zero_where(name, routing, data, c, |i, k| i / 2 != k / 2 || i / 2 > j);
+        }
+    });
 }
 
 #[test]
