@@ -3,12 +3,18 @@
 //!
 //! Install it once per test binary, then count around the calls:
 //!
-//! ```ignore
-//! #[global_allocator]
-//! static GLOBAL: sinew_testkit::alloc::CountingAllocator = sinew_testkit::alloc::CountingAllocator;
+//! ```
+//! use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 //!
-//! let (allocations, ()) = sinew_testkit::alloc::count(|| { /* evaluate */ });
-//! assert_eq!(allocations, 0);
+//! #[global_allocator]
+//! static GLOBAL: CountingAllocator = CountingAllocator;
+//!
+//! fn main() {
+//!     assert_counting();
+//!     let buffer = vec![1.0_f64; 8];
+//!     let (allocations, sum) = count(|| buffer.iter().sum::<f64>());
+//!     assert_eq!((allocations, sum), (0, 8.0));
+//! }
 //! ```
 //!
 //! The counter is global (every thread), as the allocations it must catch may happen on any

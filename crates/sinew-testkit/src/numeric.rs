@@ -99,3 +99,30 @@ pub fn central_difference(q: &[f64], h: f64, mut f: impl FnMut(&[f64]) -> Vec<f6
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn central_differences_of_a_quadratic_are_exact_to_round_off() {
+        // f(q) = [q0² + q1, q0·q1]: J = [[2 q0, 1], [q1, q0]]; central differences of a
+        // quadratic have no truncation error.
+        let q = [0.3, -0.7];
+        let numeric = central_difference(&q, H, |q| vec![q[0] * q[0] + q[1], q[0] * q[1]]);
+        let expected = Mat::from_fn(2, 2, |r, c| [[2.0 * q[0], 1.0], [q[1], q[0]]][r][c]);
+        assert!(rel_err(expected.as_ref(), numeric.as_ref()) <= 1e-9);
+    }
+
+    #[test]
+    fn the_two_relative_errors_differ_only_in_their_scale() {
+        let a = column(&[0.5, -0.25]);
+        let b = column(&[0.5, -0.5]);
+        assert_eq!(max_diff_and_scale(a.as_ref(), b.as_ref()), (0.25, 0.5));
+        // Floor 1 on the analytic scale; relative to the reference's largest entry.
+        assert_eq!(rel_err(a.as_ref(), b.as_ref()), 0.25);
+        assert_eq!(rel_diff(a.as_ref(), b.as_ref()), 0.5);
+        assert_eq!(rel_diff(a.as_ref(), a.as_ref()), 0.0);
+        assert_eq!(perturbed(&[1.0, 2.0], 1, 0.5), (vec![1.0, 2.5], vec![1.0, 1.5]));
+    }
+}
