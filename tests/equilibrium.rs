@@ -18,6 +18,7 @@ use rand::Rng;
 use sinew::robot::{Robot, RobotData};
 use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
 use sinew::stiffness::{ArmStiffness, stability_margin};
+use sinew_testkit::numeric::central_difference;
 use sinew_testkit::{cdhrm5, config};
 
 use sinew::paper::E4_Q;
@@ -68,18 +69,7 @@ impl Elastic<'_> {
             if norm < 1e-10 {
                 return q;
             }
-            let h = 1e-7;
-            let mut jac = Mat::<f64>::zeros(n, n);
-            for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += h;
-                qm[i] -= h;
-                let (rp, rm) = (self.residual(&qp, dw), self.residual(&qm, dw));
-                for j in 0..n {
-                    jac[(j, i)] = (rp[j] - rm[j]) / (2.0 * h);
-                }
-            }
+            let jac = central_difference(&q, 1e-7, |q| self.residual(q, dw));
             let rhs = Mat::from_fn(n, 1, |i, _| -r[i]);
             let step = jac.partial_piv_lu().solve(rhs);
             // Backtracking: halve the step until the residual decreases.
