@@ -3,11 +3,12 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use sinew_stiffness::{
     EndStiffnessData, StiffnessError, end_compliance, end_stiffness, stability_margin,
 };
+use sinew_testkit::config;
 use sinew_testkit::numeric::max_abs;
 
 fn random(rng: &mut ChaCha8Rng, r: usize, c: usize) -> Mat<f64> {
@@ -26,7 +27,7 @@ fn spd(rng: &mut ChaCha8Rng, n: usize) -> Mat<f64> {
 
 #[test]
 fn compliance_is_j_a_inverse_jt_and_stiffness_its_inverse() {
-    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let mut rng = config::rng(41);
     for (n, symmetric) in [(10, true), (10, false), (40, true), (40, false)] {
         let k_q = spd(&mut rng, n);
         // A small non-symmetric K_W (a base-fixed moment) keeps the symmetric part definite.
@@ -69,7 +70,7 @@ fn compliance_is_j_a_inverse_jt_and_stiffness_its_inverse() {
 
 #[test]
 fn an_indefinite_joint_stiffness_is_an_unstable_equilibrium() {
-    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    let mut rng = config::rng(42);
     let n = 10;
     let mut k_q = Mat::<f64>::identity(n, n);
     k_q[(3, 3)] = -0.5;
@@ -92,7 +93,7 @@ fn an_indefinite_joint_stiffness_is_an_unstable_equilibrium() {
 
 #[test]
 fn a_rank_deficient_jacobian_is_reported_and_keeps_the_compliance() {
-    let mut rng = ChaCha8Rng::seed_from_u64(43);
+    let mut rng = config::rng(43);
     let n = 10;
     let k_q = spd(&mut rng, n);
     let k_w = Mat::zeros(n, n);
@@ -110,7 +111,7 @@ fn a_rank_deficient_jacobian_is_reported_and_keeps_the_compliance() {
 
 #[test]
 fn a_singular_translational_block_has_no_translational_stiffness() {
-    let mut rng = ChaCha8Rng::seed_from_u64(44);
+    let mut rng = config::rng(44);
     let n = 10;
     let k_q = spd(&mut rng, n);
     let k_w = Mat::zeros(n, n);
