@@ -14,13 +14,12 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use nalgebra::{Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::Rng;
 use sinew::robot::{Robot, RobotData};
 use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
 use sinew::stiffness::{ArmStiffness, stability_margin};
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
+use sinew_testkit::numeric::central_difference;
+use sinew_testkit::{cdhrm5, config};
 
 use sinew::paper::E4_Q;
 
@@ -70,18 +69,7 @@ impl Elastic<'_> {
             if norm < 1e-10 {
                 return q;
             }
-            let h = 1e-7;
-            let mut jac = Mat::<f64>::zeros(n, n);
-            for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += h;
-                qm[i] -= h;
-                let (rp, rm) = (self.residual(&qp, dw), self.residual(&qm, dw));
-                for j in 0..n {
-                    jac[(j, i)] = (rp[j] - rm[j]) / (2.0 * h);
-                }
-            }
+            let jac = central_difference(&q, 1e-7, |q| self.residual(q, dw));
             let rhs = Mat::from_fn(n, 1, |i, _| -r[i]);
             let step = jac.partial_piv_lu().solve(rhs);
             // Backtracking: halve the step until the residual decreases.
@@ -162,12 +150,11 @@ fn check(
 }
 
 fn setups() -> Vec<(&'static str, Robot, Routing)> {
-    let robot = sinew::robot::load(ROBOT_DIR).unwrap();
-    ["cables.toml", "cables-routed.toml"]
+    cdhrm5::MODELS
         .into_iter()
-        .map(|file| {
-            let routing = sinew::routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
-            (file, robot.clone(), routing)
+        .map(|model| {
+            let (robot, routing) = cdhrm5::robot_and_routing(model);
+            (cdhrm5::routing_file(model), robot, routing)
         })
         .collect()
 }
@@ -200,13 +187,12 @@ fn compliance_matches_the_nonlinear_equilibrium_at_e4() {
 #[test]
 fn compliance_matches_the_nonlinear_equilibrium_at_random_stable_configurations() {
     for (name, robot, routing) in setups() {
-        let mut rng = ChaCha8Rng::seed_from_u64(71);
+        let mut rng = config::rng(71);
         let (mut checked, mut tried, mut worst, mut worst_one_sided) = (0, 0, 0.0_f64, 0.0_f64);
         while checked < 20 {
             tried += 1;
             assert!(tried < 5000, "{name}: too few feasible stable configurations");
-            let q: Vec<f64> =
-                robot.joints().iter().map(|j| rng.random_range(j.lower..=j.upper)).collect();
+            let q: Vec<f64> = config::random_q(&robot, &mut rng);
             let load = Vector6::new(
                 rng.random_range(-2.0..2.0),
                 rng.random_range(-2.0..2.0),

@@ -37,6 +37,7 @@ use nalgebra_lm::{DMatrix, DVector, Dyn, Owned};
 use sinew::paper::{Table2Row, render_table_2, table_2_patterns};
 use sinew::robot::UniformChain;
 use sinew::routing::{PatternModel, PerJoint, Routing, RoutingSpec};
+use sinew_testkit::cdhrm5;
 
 use crate::DynResult;
 
@@ -116,12 +117,12 @@ impl Geometry {
 
 /// `E·A` of the cdhrm5 cables (Table I's E = 12.5 GPa, a 1 mm cable as the files say), N.
 fn ea() -> f64 {
-    12.5e9 * PI * 0.25 * 1.0e-3_f64.powi(2)
+    cdhrm5::YOUNGS_MODULUS * PI * 0.25 * cdhrm5::DIAMETER.powi(2)
 }
 
 /// A chain of `joints` cdhrm5 joints with the geometry's d1, d2.
 fn chain(g: &Geometry, joints: usize) -> UniformChain {
-    UniformChain { d1: g.d1, d2: g.d2, ..UniformChain::like_cdhrm5(joints) }
+    UniformChain { d1: g.d1, d2: g.d2, ..cdhrm5::uniform_chain(joints) }
 }
 
 /// Table II (the same computation as the report's, [`sinew::paper::table_2`]) of a one-joint
@@ -129,7 +130,7 @@ fn chain(g: &Geometry, joints: usize) -> UniformChain {
 fn table(g: &Geometry) -> DynResult<Vec<Table2Row>> {
     let chain = chain(g, 1);
     let robot = chain.build()?;
-    let mut spec = RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled);
+    let mut spec = cdhrm5::chain_routing_spec(&chain, PatternModel::Decoupled);
     spec.free_length = Some(PerJoint::Uniform(g.free_length(ea())));
     if let Some(pattern) = spec.pattern.as_mut() {
         pattern.radius = None;

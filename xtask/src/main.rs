@@ -52,7 +52,7 @@ fn project_root() -> PathBuf {
 fn gen_chain(args: &[String]) -> DynResult<()> {
     let mut joints = None;
     let mut out = None;
-    let mut chain = sinew::robot::UniformChain::like_cdhrm5(1);
+    let mut chain = sinew_testkit::cdhrm5::uniform_chain(1);
     let mut mass_per_link = None;
     let mut it = args.iter();
     while let Some(flag) = it.next() {

@@ -18,8 +18,6 @@ use sinew::routing::Routing;
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError, stability_margin};
 use tempfile::TempDir;
 
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
-
 /// A private copy of cdhrm5, loaded through the library.
 struct Fixture {
     dir: TempDir,
@@ -31,7 +29,7 @@ struct Fixture {
 impl Fixture {
     fn new() -> Fixture {
         let dir = tempfile::tempdir().unwrap();
-        for entry in std::fs::read_dir(ROBOT_DIR).unwrap() {
+        for entry in std::fs::read_dir(sinew_testkit::cdhrm5::dir()).unwrap() {
             let entry = entry.unwrap();
             if entry.file_type().unwrap().is_file() {
                 std::fs::copy(entry.path(), dir.path().join(entry.file_name())).unwrap();

@@ -8,15 +8,12 @@ use faer::Mat;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use sinew_indicators::{AngleGrid, IndicatorError, JointProbe, StiffnessEllipsoid, sweep_joint};
 use sinew_robot::{Robot, RobotData};
-use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_stiffness::{joint_block, joint_stiffness};
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+use sinew_testkit::cdhrm5;
 
 fn cdhrm5() -> (Robot, Routing) {
-    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(ROBOT_DIR, &robot).unwrap();
-    (robot, routing)
+    cdhrm5::robot_and_routing(PatternModel::Decoupled)
 }
 
 #[test]

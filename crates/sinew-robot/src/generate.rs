@@ -47,23 +47,6 @@ pub struct UniformChain {
 }
 
 impl UniformChain {
-    /// A chain with the platform's link (φ60 × 220 mm), 0.24 kg per link, ±π/6 limits,
-    /// d1 = 30 mm, d2 = 0 (fitted to Table II) and a horizontal mounting (gravity along +y), for
-    /// `joints` joints: the values of `robots/cdhrm5` (its README says why).
-    pub fn like_cdhrm5(joints: usize) -> UniformChain {
-        UniformChain {
-            name: format!("uniform{joints}"),
-            joints,
-            d1: 0.03,
-            d2: 0.0,
-            link_length: 0.22,
-            link_radius: 0.03,
-            total_mass: 0.24 * joints as f64,
-            limit: std::f64::consts::FRAC_PI_6,
-            gravity: Vector3::new(0.0, 9.81, 0.0),
-        }
-    }
-
     /// The settings beside the URDF: tip link `end_effector` and the gravity vector.
     pub fn settings(&self) -> ChainSettings {
         ChainSettings { tip_link: "end_effector".to_owned(), gravity: self.gravity }

@@ -1,11 +1,10 @@
 //! Every malformed input is a distinct typed error whose message names the element at fault.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
-
 use nalgebra::Vector3;
 use proptest::prelude::*;
 use sinew_robot::{ChainSettings, Robot, RobotData, RobotError, UniformChain};
+use sinew_testkit::cdhrm5;
 
 fn settings() -> ChainSettings {
     ChainSettings { tip_link: "tip".to_owned(), gravity: Vector3::new(0.0, 0.0, -9.81) }
@@ -195,7 +194,7 @@ fn unknown_tip_link() {
 
 #[test]
 fn no_revolute_joint() {
-    let err = UniformChain { joints: 0, ..UniformChain::like_cdhrm5(0) }.build().unwrap_err();
+    let err = UniformChain { joints: 0, ..cdhrm5::uniform_chain(0) }.build().unwrap_err();
     assert!(matches!(err, RobotError::NoJoints { .. }), "{err:?}");
 }
 
@@ -222,7 +221,7 @@ fn wrong_configuration_length_nan_and_out_of_limits() {
 #[test]
 fn workspace_of_another_robot() {
     let robot = load(&valid()).unwrap();
-    let other = common::cdhrm5();
+    let other = cdhrm5::robot();
     let mut data = RobotData::new(&other);
     let err = robot.forward_kinematics(&mut data, &[0.0, 0.0]).unwrap_err();
     assert!(matches!(err, RobotError::WorkspaceMismatch { data_dof: 10, robot_dof: 2 }), "{err:?}");

@@ -1,22 +1,21 @@
 //! Forward kinematics against hand-computed values and an independent product of transforms.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
-
 use approx::assert_relative_eq;
 use nalgebra::{Matrix4, Vector3};
 use sinew_robot::RobotData;
+use sinew_testkit::{cdhrm5, config};
 
 // The platform's geometry as chosen in robots/cdhrm5/README.md (d1, d2 fitted to Table II by
 // `cargo xtask calibrate`: the joint centre on the distal disc).
-const D1: f64 = 0.03;
-const D2: f64 = 0.0;
+const D1: f64 = cdhrm5::D1_D2.0;
+const D2: f64 = cdhrm5::D1_D2.1;
 const LINK: f64 = 0.22;
 const JOINTS: usize = 5;
 
 #[test]
 fn tip_at_zero_is_the_stacked_lengths() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     assert_eq!(robot.dof(), 2 * JOINTS);
     let mut data = RobotData::new(&robot);
     robot.forward_kinematics(&mut data, &[0.0; 10]).unwrap();
@@ -55,11 +54,11 @@ fn rot_y(q: f64) -> Matrix4<f64> {
 
 #[test]
 fn tip_at_random_q_is_the_product_of_eq1_transforms() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     let mut data = RobotData::new(&robot);
-    let mut rng = common::rng(1);
+    let mut rng = config::rng(1);
     for _ in 0..100 {
-        let q = common::random_q(&robot, &mut rng);
+        let q = config::random_q(&robot, &mut rng);
         robot.forward_kinematics(&mut data, &q).unwrap();
         let tip = robot.tip_pose(&data).unwrap().to_homogeneous();
         // eq. 1 per joint, then the link from O'_i to the next disc O_{i+1}.
@@ -78,7 +77,7 @@ fn tip_at_random_q_is_the_product_of_eq1_transforms() {
 
 #[test]
 fn link_points_resolve_through_fixed_joints() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     let mut data = RobotData::new(&robot);
     let q = [0.2, -0.1, 0.3, 0.05, -0.2, 0.1, 0.0, 0.4, -0.3, 0.25];
     robot.forward_kinematics(&mut data, &q).unwrap();
@@ -95,7 +94,7 @@ fn link_points_resolve_through_fixed_joints() {
 
 #[test]
 fn mass_is_folded_into_bodies() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     assert_relative_eq!(robot.moving_mass(), 1.2, epsilon = 1e-12);
     // Body of joint1_y carries link1: 0.24 kg, centre of mass d2 + 0.11 m beyond the pivot.
     let body = &robot.bodies()[2];
@@ -108,7 +107,7 @@ fn mass_is_folded_into_bodies() {
 
 #[test]
 fn gravity_comes_from_the_description() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     assert_eq!(robot.gravity(), Vector3::new(0.0, 9.81, 0.0));
     let mut data = RobotData::new(&robot);
     robot.forward_kinematics(&mut data, &[0.0; 10]).unwrap();

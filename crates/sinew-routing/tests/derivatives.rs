@@ -6,15 +6,13 @@
 //! errors measured.
 #![allow(clippy::unwrap_used, clippy::expect_used, non_snake_case)]
 
-mod common;
-
-use common::{H, RTOL, max_diff_and_scale, random_q, rng};
 use faer::Mat;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use sinew_robot::{RobotData, UniformChain};
-use sinew_routing::{
-    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry, spec,
-};
+use sinew_robot::RobotData;
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
+use sinew_testkit::cdhrm5;
+use sinew_testkit::config::{random_q, rng};
+use sinew_testkit::numeric::{H, RTOL, max_abs, max_diff_and_scale};
 
 /// eq. (1): `T = Trans(0,0,d1) · Rot(x, q1) · Rot(y, q2) · Trans(0,0,d2)`.
 fn eq1(d1: f64, d2: f64, q1: f64, q2: f64) -> Isometry3<f64> {
@@ -38,17 +36,14 @@ fn eq2(r: Vector3<f64>, r_prime: Vector3<f64>, T: &Isometry3<f64>) -> f64 {
 #[test]
 fn one_joint_length_is_eq_2() {
     // A generated single joint, holes computed here from the pattern's constants.
-    let chain = UniformChain::like_cdhrm5(1);
+    let chain = cdhrm5::uniform_chain(1);
     let robot = chain.build().unwrap();
-    let routing = Routing::new(
-        &robot,
-        &RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled),
-        "<1>",
-    )
-    .unwrap();
+    let routing =
+        Routing::new(&robot, &cdhrm5::chain_routing_spec(&chain, PatternModel::Decoupled), "<1>")
+            .unwrap();
     let mut rdata = RobotData::new(&robot);
     let mut data = RoutingData::new(&routing);
-    let rho = spec::CDHRM5_HOLE_RADIUS;
+    let rho = cdhrm5::HOLE_RADIUS;
     let mut rng = rng(1);
     let mut worst: f64 = 0.0;
     for _ in 0..100 {
@@ -57,7 +52,7 @@ fn one_joint_length_is_eq_2() {
             .unwrap();
         let T = eq1(chain.d1, chain.d2, q[0], q[1]);
         for k in 0..3 {
-            let theta = spec::CDHRM5_THETA0 + std::f64::consts::TAU * k as f64 / 3.0;
+            let theta = cdhrm5::THETA0 + std::f64::consts::TAU * k as f64 / 3.0;
             let r = Vector3::new(rho * theta.cos(), rho * theta.sin(), 0.0);
             let expected = eq2(r, r, &T);
             let got = data.lengths().unwrap()[k];
@@ -75,8 +70,8 @@ fn one_joint_length_is_eq_2() {
 fn every_cdhrm5_joint_length_is_eq_2() {
     // Every joint of the platform: the holes as the routing file places them (link frames of
     // the proximal and distal discs are O_i and O'_i), T from that joint's two angles only.
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     let mut rdata = RobotData::new(&robot);
     let mut data = RoutingData::new(&routing);
     let mut rng = rng(2);
@@ -119,7 +114,7 @@ fn check_against_finite_differences(name: &str, robot: &sinew_robot::Robot, rout
         compute_cable_geometry(routing, robot, &mut rdata, &mut data, &q, Order::Hessians).unwrap();
         for c in 0..m {
             data.cable_hessian(routing, c, hessians[c].as_mut()).unwrap();
-            let own = max_diff_and_scale(hessians[c].as_ref(), hessians[c].as_ref()).1;
+            let own = max_abs(hessians[c].as_ref());
             assert!(own > 0.0, "{name}: cable {c} has a zero Hessian");
             // The Hessian is a difference of J_c: its round-off floor scales with the cable's
             // own Jacobian row (m/rad), which also floors the scale when H_c is nearly zero
@@ -174,33 +169,33 @@ fn check_against_finite_differences(name: &str, robot: &sinew_robot::Robot, rout
 
 #[test]
 fn cdhrm5_decoupled_matches_finite_differences() {
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     check_against_finite_differences("cdhrm5 decoupled", &robot, &routing);
 }
 
 #[test]
 fn cdhrm5_routed_matches_finite_differences() {
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Routed);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Routed);
     check_against_finite_differences("cdhrm5 routed", &robot, &routing);
 }
 
 #[test]
 fn chain50_decoupled_matches_finite_differences() {
-    let (robot, routing) = common::chain(50, PatternModel::Decoupled);
+    let (robot, routing) = cdhrm5::chain(50, PatternModel::Decoupled);
     check_against_finite_differences("uniform50 decoupled", &robot, &routing);
 }
 
 #[test]
 fn chain50_routed_matches_finite_differences() {
-    let (robot, routing) = common::chain(50, PatternModel::Routed);
+    let (robot, routing) = cdhrm5::chain(50, PatternModel::Routed);
     check_against_finite_differences("uniform50 routed", &robot, &routing);
 }
 
 #[test]
 fn hessians_are_symmetric_and_sum_as_weighted() {
-    for (name, robot, routing) in common::cases() {
+    for (name, robot, routing) in cdhrm5::cases(50) {
         let (n, m) = (robot.dof(), routing.cable_count());
         let mut rdata = RobotData::new(&robot);
         let mut data = RoutingData::new(&routing);

@@ -2,7 +2,7 @@
 //! field at fault; no text, however malformed, makes loading panic.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
+use sinew_testkit::cdhrm5;
 
 use proptest::prelude::*;
 use sinew_robot::{ChainSettings, Robot, RobotData};
@@ -57,7 +57,7 @@ fn pattern(proximal: &str, distal: &str) -> String {
 }
 
 fn load(text: &str) -> Result<Routing, RoutingError> {
-    Routing::from_toml_str(text, FILE, &common::cdhrm5())
+    Routing::from_toml_str(text, FILE, &cdhrm5::robot())
 }
 
 /// The error of loading `text`, checked to name the file and every given word.
@@ -81,7 +81,7 @@ fn the_templates_are_valid() {
 
 #[test]
 fn missing_file() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     let err = sinew_routing::load("/nonexistent/robot", &robot).unwrap_err();
     assert!(matches!(err, RoutingError::Io { .. }), "{err:?}");
     assert!(err.to_string().contains("/nonexistent/robot"), "{err}");
@@ -357,8 +357,8 @@ fn load_and_evaluate(robot: &Robot, text: &str) {
 /// The valid files the mutations start from: both cdhrm5 files and an explicit one.
 fn valid_files() -> Vec<String> {
     vec![
-        std::fs::read_to_string(format!("{}/cables.toml", common::CDHRM5)).unwrap(),
-        std::fs::read_to_string(format!("{}/cables-routed.toml", common::CDHRM5)).unwrap(),
+        std::fs::read_to_string(cdhrm5::dir().join("cables.toml")).unwrap(),
+        std::fs::read_to_string(cdhrm5::dir().join("cables-routed.toml")).unwrap(),
         explicit(GOOD_CABLE),
     ]
 }
@@ -416,12 +416,12 @@ proptest! {
 
     #[test]
     fn arbitrary_text_never_panics(text in any::<String>()) {
-        load_and_evaluate(&common::cdhrm5(), &text);
+        load_and_evaluate(&cdhrm5::robot(), &text);
     }
 
     #[test]
     fn toml_like_text_never_panics(text in "[a-z_\\[\\]=\". 0-9,{}\\n-]{0,200}") {
-        load_and_evaluate(&common::cdhrm5(), &text);
+        load_and_evaluate(&cdhrm5::robot(), &text);
     }
 
     #[test]
@@ -433,6 +433,6 @@ proptest! {
         for (start, len, snippet) in edits {
             text = mutate(&text, start, len, SNIPPETS[snippet]);
         }
-        load_and_evaluate(&common::cdhrm5(), &text);
+        load_and_evaluate(&cdhrm5::robot(), &text);
     }
 }

@@ -2,30 +2,23 @@
 //! lower-triangular (routed) `J_c`, exact zeros, `K_l`, the two file forms, the printed view.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
-
 use std::fmt::Write as _;
 
-use common::{random_q, rng};
 use faer::Mat;
-use sinew_robot::{RobotData, UniformChain};
+use sinew_robot::{Robot, RobotData, UniformChain};
 use sinew_routing::{
-    Order, PatternModel, PerJoint, Routing, RoutingData, RoutingError, RoutingModel, RoutingSpec,
+    Order, PatternModel, PerJoint, Routing, RoutingData, RoutingError, RoutingModel,
     compute_cable_geometry, compute_cable_geometry_from_kinematics,
 };
+use sinew_testkit::cdhrm5;
+use sinew_testkit::config::{random_q, rng};
 
 /// The least moment arm counted as "non-zero": a hole radius of 22 mm gives arms of that order.
 const NONZERO: f64 = 1e-4;
 
-// The cdhrm5 values that `cargo xtask calibrate` fitted to Table II (robots/cdhrm5/README.md),
-// as the library's generated pattern carries them.
-/// d1, d2 of cdhrm5, m: the joint centre on the distal disc.
-const CDHRM5_D: (f64, f64) = (0.03, 0.0);
-use sinew_routing::spec::{CDHRM5_FREE_LENGTH, CDHRM5_HOLE_RADIUS as CDHRM5_RADIUS, CDHRM5_THETA0};
-
 #[test]
 fn cables_are_ordered_by_joint_three_each() {
-    for (name, robot, routing) in common::cases() {
+    for (name, robot, routing) in cdhrm5::cases(50) {
         let n = robot.dof() / 2;
         assert_eq!(routing.cable_count(), 3 * n, "{name}");
         let expected: Vec<usize> = (0..3 * n).map(|c| c / 3).collect();
@@ -41,93 +34,101 @@ fn cables_are_ordered_by_joint_three_each() {
     }
 }
 
-#[test]
-fn decoupled_jacobian_is_block_diagonal() {
-    for (name, robot, routing) in common::cases() {
-        if routing.model() != RoutingModel::Decoupled {
+/// `check(name, robot, routing, data)` at 100 random configurations (seeded with `seed`) of
+/// every case of `model`, after the geometry with Hessians.
+fn at_random_configurations(
+    model: RoutingModel,
+    seed: u64,
+    mut check: impl FnMut(&str, &Robot, &Routing, &RoutingData),
+) {
+    for (name, robot, routing) in cdhrm5::cases(50) {
+        if routing.model() != model {
             continue;
         }
         let mut rdata = RobotData::new(&robot);
         let mut data = RoutingData::new(&routing);
-        let mut h = Mat::<f64>::zeros(robot.dof(), robot.dof());
-        let mut rng = rng(21);
+        let mut rng = rng(seed);
         for _ in 0..100 {
             let q = random_q(&robot, &mut rng);
             compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Hessians)
                 .unwrap();
-            let jacobian = data.jacobian().unwrap();
-            for (c, cable) in routing.cables().iter().enumerate() {
-                let own = 2 * cable.joint..2 * cable.joint + 2;
-                assert_eq!(cable.dofs, own, "{name}: {}", cable.name);
-                for k in 0..robot.dof() {
-                    if own.contains(&k) {
-                        continue;
-                    }
-                    assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
-                }
-                let arm = jacobian[(c, own.start)].abs() + jacobian[(c, own.start + 1)].abs();
-                assert!(arm > NONZERO, "{name}: {} has no moment arm on its joint", cable.name);
-                data.cable_hessian(&routing, c, h.as_mut()).unwrap();
-                for i in 0..robot.dof() {
-                    for k in 0..robot.dof() {
-                        if !(own.contains(&i) && own.contains(&k)) {
-                            assert_eq!(h[(i, k)], 0.0, "{name}: H of {} at ({i}, {k})", cable.name);
-                        }
-                    }
-                }
+            check(&name, &robot, &routing, &data);
+        }
+    }
+}
+
+/// The Hessian of cable `c` is exactly zero at every `(i, k)` where `zero(i, k)`.
+fn assert_hessian_zero_where(
+    name: &str,
+    routing: &Routing,
+    data: &RoutingData,
+    c: usize,
+    zero: impl Fn(usize, usize) -> bool,
+) {
+    let n = data.jacobian().unwrap().ncols();
+    let mut h = Mat::<f64>::zeros(n, n);
+    data.cable_hessian(routing, c, h.as_mut()).unwrap();
+    let cable = &routing.cables()[c].name;
+    for i in 0..n {
+        for k in 0..n {
+            if zero(i, k) {
+                assert_eq!(h[(i, k)], 0.0, "{name}: H of {cable} at ({i}, {k})");
             }
         }
     }
+}
+
+#[test]
+fn decoupled_jacobian_is_block_diagonal() {
+    at_random_configurations(RoutingModel::Decoupled, 21, |name, robot, routing, data| {
+        let jacobian = data.jacobian().unwrap();
+        for (c, cable) in routing.cables().iter().enumerate() {
+            let own = 2 * cable.joint..2 * cable.joint + 2;
+            assert_eq!(cable.dofs, own, "{name}: {}", cable.name);
+            for k in 0..robot.dof() {
+                if own.contains(&k) {
+                    continue;
+                }
+                assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
+            }
+            let arm = jacobian[(c, own.start)].abs() + jacobian[(c, own.start + 1)].abs();
+            assert!(arm > NONZERO, "{name}: {} has no moment arm on its joint", cable.name);
+            assert_hessian_zero_where(name, routing, data, c, |i, k| {
+                !(own.contains(&i) && own.contains(&k))
+            });
+        }
+    });
 }
 
 #[test]
 fn routed_jacobian_is_block_lower_triangular_with_proximal_blocks() {
-    for (name, robot, routing) in common::cases() {
-        if routing.model() != RoutingModel::Routed {
-            continue;
-        }
-        let mut rdata = RobotData::new(&robot);
-        let mut data = RoutingData::new(&routing);
-        let mut h = Mat::<f64>::zeros(robot.dof(), robot.dof());
-        let mut rng = rng(22);
-        for _ in 0..100 {
-            let q = random_q(&robot, &mut rng);
-            compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Hessians)
-                .unwrap();
-            let jacobian = data.jacobian().unwrap();
-            for (c, cable) in routing.cables().iter().enumerate() {
-                let j = cable.joint;
-                assert_eq!(cable.dofs, 0..2 * j + 2, "{name}: {}", cable.name);
-                for k in 2 * j + 2..robot.dof() {
-                    assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
-                }
-                // Every joint up to its own carries it: non-zero blocks, proximal ones included.
-                for p in 0..=j {
-                    let arm = jacobian[(c, 2 * p)].abs() + jacobian[(c, 2 * p + 1)].abs();
-                    assert!(
-                        arm > NONZERO,
-                        "{name}: {} has no moment arm on joint {p} ({arm:.2e})",
-                        cable.name
-                    );
-                }
-                // Each segment crosses one universal joint: H_c is block diagonal in 2 × 2
-                // blocks over the joints 0..=j.
-                data.cable_hessian(&routing, c, h.as_mut()).unwrap();
-                for i in 0..robot.dof() {
-                    for k in 0..robot.dof() {
-                        if i / 2 != k / 2 || i / 2 > j {
-                            assert_eq!(h[(i, k)], 0.0, "{name}: H of {} at ({i}, {k})", cable.name);
-                        }
-                    }
-                }
+    at_random_configurations(RoutingModel::Routed, 22, |name, robot, routing, data| {
+        let jacobian = data.jacobian().unwrap();
+        for (c, cable) in routing.cables().iter().enumerate() {
+            let j = cable.joint;
+            assert_eq!(cable.dofs, 0..2 * j + 2, "{name}: {}", cable.name);
+            for k in 2 * j + 2..robot.dof() {
+                assert_eq!(jacobian[(c, k)], 0.0, "{name}: J[{}, {k}]", cable.name);
             }
+            // Every joint up to its own carries it: non-zero blocks, proximal ones included.
+            for p in 0..=j {
+                let arm = jacobian[(c, 2 * p)].abs() + jacobian[(c, 2 * p + 1)].abs();
+                assert!(
+                    arm > NONZERO,
+                    "{name}: {} has no moment arm on joint {p} ({arm:.2e})",
+                    cable.name
+                );
+            }
+            // Each segment crosses one universal joint: H_c is block diagonal in 2 × 2
+            // blocks over the joints 0..=j.
+            assert_hessian_zero_where(name, routing, data, c, |i, k| i / 2 != k / 2 || i / 2 > j);
         }
-    }
+    });
 }
 
 #[test]
 fn cable_stiffness_is_ea_over_elastic_length() {
-    for (name, robot, routing) in common::cases() {
+    for (name, robot, routing) in cdhrm5::cases(50) {
         let mut rdata = RobotData::new(&robot);
         let mut data = RoutingData::new(&routing);
         let zero = vec![0.0; robot.dof()];
@@ -145,7 +146,7 @@ fn cable_stiffness_is_ea_over_elastic_length() {
             // Both models give every cable the same elastic length: the free length (cdhrm5's
             // calibrated one, 3.6 m for the generated chain) + 0.25 m per link before its joint
             // + its 30 mm crossing.
-            let free = CDHRM5_FREE_LENGTH;
+            let free = cdhrm5::FREE_LENGTH;
             let expected_l = free + 0.25 * cable.joint as f64 + 0.03;
             assert!(
                 (cable.elastic_length - expected_l).abs() < 1e-12,
@@ -166,8 +167,8 @@ fn cable_stiffness_is_ea_over_elastic_length() {
 fn cdhrm5_inherent_stiffness_at_zero_is_table_ii_order() {
     // The free length was chosen so that joint 1's inherent stiffness J_cᵀ K_l J_c at Q = 0 is
     // inside Table II's K_x = [1.92, 1.98] N m/rad (robots/cdhrm5/README.md).
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     let mut rdata = RobotData::new(&robot);
     let mut data = RoutingData::new(&routing);
     compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &[0.0; 10], Order::Jacobian)
@@ -182,22 +183,22 @@ fn cdhrm5_inherent_stiffness_at_zero_is_table_ii_order() {
 
 #[test]
 fn cdhrm5_files_match_the_generated_pattern() {
-    let robot = common::cdhrm5();
-    let (d1, d2) = CDHRM5_D;
-    let chain = UniformChain { d1, d2, ..UniformChain::like_cdhrm5(5) };
+    let robot = cdhrm5::robot();
+    let (d1, d2) = cdhrm5::D1_D2;
+    let chain = UniformChain { d1, d2, ..cdhrm5::uniform_chain(5) };
     for model in [PatternModel::Decoupled, PatternModel::Routed] {
-        let from_file = common::cdhrm5_routing(&robot, model);
-        let mut spec = RoutingSpec::for_uniform_chain(&chain, model);
+        let from_file = cdhrm5::routing(&robot, model);
+        let mut spec = cdhrm5::chain_routing_spec(&chain, model);
         let pitch = d1 + d2 + chain.link_length;
         spec.free_length = Some(match model {
             PatternModel::Decoupled => {
-                PerJoint::Each((0..5).map(|i| CDHRM5_FREE_LENGTH + i as f64 * pitch).collect())
+                PerJoint::Each((0..5).map(|i| cdhrm5::FREE_LENGTH + i as f64 * pitch).collect())
             }
-            PatternModel::Routed => PerJoint::Uniform(CDHRM5_FREE_LENGTH),
+            PatternModel::Routed => PerJoint::Uniform(cdhrm5::FREE_LENGTH),
         });
         let pattern = spec.pattern.as_mut().unwrap();
-        pattern.radius = Some(PerJoint::Uniform(CDHRM5_RADIUS));
-        pattern.theta0 = CDHRM5_THETA0;
+        pattern.radius = Some(PerJoint::Uniform(cdhrm5::HOLE_RADIUS));
+        pattern.theta0 = cdhrm5::THETA0;
         let generated = Routing::new(&robot, &spec, "<gen>").unwrap();
         assert_eq!(from_file.cables(), generated.cables(), "{model:?}");
         assert_eq!(from_file.segments(), generated.segments(), "{model:?}");
@@ -206,13 +207,17 @@ fn cdhrm5_files_match_the_generated_pattern() {
 
 #[test]
 fn cdhrm5_holes_are_distinct_and_inside_the_link() {
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Routed);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Routed);
     let mut anchors = Vec::new();
     for cable in routing.cables() {
         for hole in &cable.holes {
             let r = (hole.point.x.powi(2) + hole.point.y.powi(2)).sqrt();
-            assert!((r - CDHRM5_RADIUS).abs() < 1e-15 && r < 0.03, "{}: radius {r}", cable.name);
+            assert!(
+                (r - cdhrm5::HOLE_RADIUS).abs() < 1e-15 && r < 0.03,
+                "{}: radius {r}",
+                cable.name
+            );
             assert_eq!(hole.point.z, 0.0);
         }
         let p = cable.holes[cable.holes.len() - 1].point;
@@ -270,7 +275,7 @@ fn explicit_toml(routing: &Routing) -> String {
 
 #[test]
 fn explicit_and_pattern_forms_give_the_same_routing() {
-    for (name, robot, routing) in common::cases() {
+    for (name, robot, routing) in cdhrm5::cases(50) {
         let text = explicit_toml(&routing);
         let explicit = Routing::from_toml_str(&text, "<explicit>", &robot).unwrap();
         assert_eq!(explicit.model(), RoutingModel::Explicit);
@@ -290,7 +295,7 @@ fn explicit_and_pattern_forms_give_the_same_routing() {
 
 #[test]
 fn explicit_cables_derive_their_joint_and_are_sorted() {
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     // Given out of order, without `joint`: derived from the anchor and sorted (stable).
     let text = r#"
 tension_limits = [20.0, 600.0]
@@ -321,8 +326,8 @@ holes = [{ link = "link2_distal", point = [0.0, 0.02, 0.0] }, { link = "link3", 
 
 #[test]
 fn printed_view_lists_every_hole() {
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Routed);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Routed);
     let view: serde_json::Value = serde_json::from_str(&routing.to_json().unwrap()).unwrap();
     assert_eq!(view["model"], "routed");
     assert_eq!(view["robot"], "cdhrm5");
@@ -342,8 +347,8 @@ fn printed_view_lists_every_hole() {
 
 #[test]
 fn evaluation_errors_are_typed() {
-    let robot = common::cdhrm5();
-    let routing = common::cdhrm5_routing(&robot, PatternModel::Decoupled);
+    let robot = cdhrm5::robot();
+    let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     let mut rdata = RobotData::new(&robot);
     let mut data = RoutingData::new(&routing);
 
@@ -377,7 +382,7 @@ fn evaluation_errors_are_typed() {
         "{err:?}"
     );
     // A routing for another robot, a workspace for another routing.
-    let (chain, chain_routing) = common::chain(50, PatternModel::Decoupled);
+    let (chain, chain_routing) = cdhrm5::chain(50, PatternModel::Decoupled);
     let mut chain_rdata = RobotData::new(&chain);
     let err = compute_cable_geometry(
         &routing,
@@ -407,7 +412,7 @@ fn evaluation_errors_are_typed() {
 fn a_segment_that_collapses_is_an_error_not_a_nan() {
     // A hole on the base at (0, 0.01, d1) and one on the cross of joint 1 (frame at the joint
     // centre, z = d1 = 0.03 m on cdhrm5) at (0, 0, 0.01): they meet at q_11 = −π/2.
-    let robot = common::cdhrm5();
+    let robot = cdhrm5::robot();
     let text = r#"
 tension_limits = [20.0, 600.0]
 [material]
@@ -442,9 +447,9 @@ fn hessian_at_zero_is_minus_d1_d2_over_d1_plus_d2() {
     // At Q = 0 a crossing segment runs along z; bending either axis shortens it by
     // d1·d2/(d1 + d2)·q²/2 whatever the hole's radius and angle (robots/cdhrm5/README.md).
     for (d1, d2) in [(0.015, 0.015), (0.01, 0.025), (0.0, 0.03)] {
-        let chain = UniformChain { d1, d2, ..UniformChain::like_cdhrm5(5) };
+        let chain = UniformChain { d1, d2, ..cdhrm5::uniform_chain(5) };
         let robot = chain.build().unwrap();
-        let spec = RoutingSpec::for_uniform_chain(&chain, PatternModel::Decoupled);
+        let spec = cdhrm5::chain_routing_spec(&chain, PatternModel::Decoupled);
         let routing = Routing::new(&robot, &spec, "<gen>").unwrap();
         let mut rdata = RobotData::new(&robot);
         let mut data = RoutingData::new(&routing);

@@ -1,61 +1,20 @@
 //! The arm's statics on cdhrm5 and a generated chain, decoupled and routed: equilibrium at every
-//! tension level, the paper's experiments E1, E2 and E4 (spec §6), and infeasible loads.
+//! tension level, the paper's experiments E1 and E2 (spec §6; E4 and the infeasible load at
+//! E4 are the facade's, tests/e4_statics.rs, beside their pose `sinew::paper::E4_Q`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::f64::consts::PI;
 
 use nalgebra::{Matrix3x2, Vector2, Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use sinew_robot::{Robot, RobotData, UniformChain};
-use sinew_routing::{
-    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
-};
-use sinew_statics::{
-    ArmStatics, InfeasibleReason, StaticsError, TensionLimits, cable_torques, tension_interval,
-};
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
-
-fn cdhrm5(file: &str) -> (Robot, Routing) {
-    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
-    (robot, routing)
-}
-
-fn setups() -> Vec<(String, Robot, Routing)> {
-    let mut v = Vec::new();
-    for file in ["cables.toml", "cables-routed.toml"] {
-        let (robot, routing) = cdhrm5(file);
-        v.push((format!("cdhrm5 {file}"), robot, routing));
-    }
-    for model in [PatternModel::Decoupled, PatternModel::Routed] {
-        let chain = UniformChain::like_cdhrm5(8);
-        let robot = chain.build().unwrap();
-        let spec = RoutingSpec::for_uniform_chain(&chain, model);
-        let routing = Routing::new(&robot, &spec, "<generated>").unwrap();
-        v.push((format!("uniform8 {model:?}"), robot, routing));
-    }
-    v
-}
-
-/// The E4 configuration (spec §6).
-const E4_Q: [f64; 10] = [
-    -PI / 7.0,
-    -PI / 9.0,
-    -PI / 9.0,
-    -PI / 11.0,
-    PI / 6.0,
-    PI / 7.0,
-    PI / 8.0,
-    -PI / 15.0,
-    -PI / 12.0,
-    -PI / 10.0,
-];
+use rand::Rng;
+use sinew_robot::RobotData;
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::{ArmStatics, StaticsError, TensionLimits, cable_torques, tension_interval};
+use sinew_testkit::{cdhrm5, config};
 
 #[test]
 fn every_level_balances_t0_at_random_configurations_and_loads() {
-    for (name, robot, routing) in setups() {
+    for (name, robot, routing) in cdhrm5::cases(8) {
         // Gravity off, so that random loads of a few newtons stay feasible on long chains.
         let robot = robot.with_gravity(Vector3::zeros());
         let statics = ArmStatics::new(&routing).unwrap();
@@ -63,11 +22,10 @@ fn every_level_balances_t0_at_random_configurations_and_loads() {
         let mut rdata = RobotData::new(&robot);
         let mut gdata = RoutingData::new(&routing);
         let mut data = statics.data(&robot);
-        let mut rng = ChaCha8Rng::seed_from_u64(51);
+        let mut rng = config::rng(51);
         let (mut solved, mut worst) = (0, 0.0_f64);
         for _ in 0..100 {
-            let q: Vec<f64> =
-                robot.joints().iter().map(|j| rng.random_range(j.lower..=j.upper)).collect();
+            let q: Vec<f64> = config::random_q(&robot, &mut rng);
             let f0 = Vector6::from_fn(|i, _| {
                 if i < 3 { rng.random_range(-1.0..1.0) } else { rng.random_range(-0.2..0.2) }
             });
@@ -106,7 +64,7 @@ fn every_level_balances_t0_at_random_configurations_and_loads() {
 
 /// One joint's 3 × 2 cable Jacobian block of cdhrm5's first joint at `q` (decoupled).
 fn joint_block(q: [f64; 2]) -> Matrix3x2<f64> {
-    let (robot, routing) = cdhrm5("cables.toml");
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
     let mut full = vec![0.0; 10];
     full[0] = q[0];
     full[1] = q[1];
@@ -142,56 +100,8 @@ fn e2_is_feasible() {
 }
 
 #[test]
-fn e4_under_the_documented_mounting() {
-    for file in ["cables.toml", "cables-routed.toml"] {
-        let (robot, routing) = cdhrm5(file);
-        let statics = ArmStatics::new(&routing).unwrap();
-        let mut rdata = RobotData::new(&robot);
-        let mut gdata = RoutingData::new(&routing);
-        let mut data = statics.data(&robot);
-        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        let result = statics
-            .solve_at(&robot, &routing, &mut rdata, &mut gdata, &mut data, &E4_Q, &f0, &[0.0; 5]);
-        println!("E4 {file}: T0 = {:.3?}", data.t0);
-        match &result {
-            Ok(()) => {
-                for i in &data.intervals {
-                    let (lo, hi) = i.ends();
-                    println!("  joint {}: f(λ_min) = {lo:.1?}, f(λ_max) = {hi:.1?}", i.joint + 1);
-                }
-            }
-            Err(e) => println!("  {e}"),
-        }
-        result.unwrap();
-    }
-}
-
-#[test]
-fn a_load_that_cannot_be_held_names_the_first_joint_that_fails() {
-    for file in ["cables.toml", "cables-routed.toml"] {
-        let (robot, routing) = cdhrm5(file);
-        let statics = ArmStatics::new(&routing).unwrap();
-        let mut rdata = RobotData::new(&robot);
-        let mut gdata = RoutingData::new(&routing);
-        let mut data = statics.data(&robot);
-        let f0 = Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0);
-        let err = statics
-            .solve_at(&robot, &routing, &mut rdata, &mut gdata, &mut data, &E4_Q, &f0, &[0.0; 5])
-            .unwrap_err();
-        println!("100 N, {file}: {err}");
-        let StaticsError::Infeasible { joint, reason, .. } = err else { panic!("{err:?}") };
-        assert!(matches!(reason, InfeasibleReason::OutsideLimits { .. }));
-        // Decoupled: solved from the base, joint 1 fails first. Routed: solved from the tip,
-        // the most distal joint that cannot hold its share fails first.
-        if file == "cables.toml" {
-            assert_eq!(joint, 0);
-        }
-    }
-}
-
-#[test]
 fn routings_that_are_not_three_cables_per_joint_are_unsupported() {
-    let robot = UniformChain::like_cdhrm5(1).build().unwrap();
+    let robot = cdhrm5::chain_robot(1);
     let mut text = String::from(
         "tension_limits = [20.0, 600.0]\nfree_length = 3.0\n[material]\nyoungs_modulus = 12.5e9\ndiameter = 1e-3\n",
     );

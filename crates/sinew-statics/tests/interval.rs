@@ -2,9 +2,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Matrix3x2, Vector2, Vector3};
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use sinew_statics::{InfeasibleReason, StaticsError, TensionLimits, tension_interval};
+use sinew_testkit::config;
 
 const LIMITS: TensionLimits = TensionLimits { f_min: 20.0, f_max: 600.0 };
 
@@ -22,7 +23,7 @@ fn joint_block(rng: &mut ChaCha8Rng) -> Matrix3x2<f64> {
 
 #[test]
 fn every_level_balances_the_torque_and_the_ends_are_exact() {
-    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let mut rng = config::rng(21);
     let mut checked = 0;
     for _ in 0..1000 {
         let jacobian = joint_block(&mut rng);
@@ -52,7 +53,7 @@ fn every_level_balances_the_torque_and_the_ends_are_exact() {
 
 #[test]
 fn a_torque_beyond_the_limits_is_infeasible_and_names_the_joint() {
-    let mut rng = ChaCha8Rng::seed_from_u64(22);
+    let mut rng = config::rng(22);
     let jacobian = joint_block(&mut rng);
     let tau = Vector2::new(100.0, 0.0);
     let err = tension_interval(3, &jacobian, &tau, LIMITS).unwrap_err();
@@ -100,7 +101,7 @@ fn a_rank_deficient_block_is_a_typed_outcome() {
 
 #[test]
 fn a_nan_torque_is_an_error_not_a_nan() {
-    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let mut rng = config::rng(23);
     let jacobian = joint_block(&mut rng);
     let err = tension_interval(0, &jacobian, &Vector2::new(f64::NAN, 0.0), LIMITS).unwrap_err();
     assert!(matches!(err, StaticsError::NonFiniteTorque { .. }), "{err:?}");

@@ -4,18 +4,14 @@
 
 use faer::Mat;
 use nalgebra::{Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use sinew_robot::{Robot, RobotData, UniformChain};
+use rand::Rng;
+use sinew_robot::{Robot, RobotData};
 use sinew_statics::{JointEndData, equilibrium_torque_derivative, equilibrium_torques};
-
-const H: f64 = 1e-6;
-const RTOL: f64 = 1e-6;
+use sinew_testkit::numeric::{H, RTOL, central_difference, rel_err};
+use sinew_testkit::{cdhrm5, config};
 
 fn robots() -> Vec<Robot> {
-    let cdhrm5 =
-        sinew_robot::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5")).unwrap();
-    vec![cdhrm5, UniformChain::like_cdhrm5(50).build().unwrap()]
+    vec![cdhrm5::robot(), cdhrm5::chain_robot(50)]
 }
 
 fn t0_at(
@@ -40,15 +36,11 @@ fn k_w_matches_finite_differences_of_t0() {
                 let n = robot.dof();
                 let mut rdata = RobotData::new(&robot);
                 let mut data = JointEndData::new(&robot);
-                let mut rng = ChaCha8Rng::seed_from_u64(31);
+                let mut rng = config::rng(31);
                 let mut k_w = Mat::zeros(n, n);
                 let mut worst: f64 = 0.0;
                 for _ in 0..100 {
-                    let q: Vec<f64> = robot
-                        .joints()
-                        .iter()
-                        .map(|j| rng.random_range(j.lower..=j.upper))
-                        .collect();
+                    let q: Vec<f64> = config::random_q(&robot, &mut rng);
                     let f0 = if loaded {
                         Vector6::from_fn(|_, _| rng.random_range(-5.0..5.0))
                     } else {
@@ -57,22 +49,9 @@ fn k_w_matches_finite_differences_of_t0() {
                     robot.forward_kinematics(&mut rdata, &q).unwrap();
                     equilibrium_torque_derivative(&robot, &mut rdata, &mut data, &f0, k_w.as_mut())
                         .unwrap();
-                    let mut scale: f64 = 1.0;
-                    let mut diff: f64 = 0.0;
-                    for i in 0..n {
-                        let mut qp = q.clone();
-                        let mut qm = q.clone();
-                        qp[i] += H;
-                        qm[i] -= H;
-                        let tp = t0_at(&robot, &mut rdata, &mut data, &qp, &f0);
-                        let tm = t0_at(&robot, &mut rdata, &mut data, &qm, &f0);
-                        for j in 0..n {
-                            let numeric = (tp[j] - tm[j]) / (2.0 * H);
-                            diff = diff.max((k_w[(j, i)] - numeric).abs());
-                            scale = scale.max(k_w[(j, i)].abs());
-                        }
-                    }
-                    worst = worst.max(diff / scale);
+                    let numeric =
+                        central_difference(&q, H, |q| t0_at(&robot, &mut rdata, &mut data, q, &f0));
+                    worst = worst.max(rel_err(k_w.as_ref(), numeric.as_ref()));
                 }
                 println!(
                     "{} gravity={gravity} F0≠0={loaded}: worst relative error {worst:.2e}",
@@ -90,7 +69,7 @@ fn k_w_is_symmetric_for_forces_and_not_for_moments() {
     let n = robot.dof();
     let mut rdata = RobotData::new(robot);
     let mut data = JointEndData::new(robot);
-    let q = [-0.45, -0.35, -0.35, -0.29, 0.52, 0.45, 0.39, -0.21, -0.26, -0.31];
+    let q = cdhrm5::LOADED_POSE;
     robot.forward_kinematics(&mut rdata, &q).unwrap();
     let mut k_w = Mat::zeros(n, n);
     let asymmetry = |k: &Mat<f64>| {

@@ -1,6 +1,7 @@
 //! `cargo bench -p sinew-stiffness`: one joint's stiffness, and the whole pipeline `Q → K_x`
 //! (kinematics, cable geometry with Hessians, T0, tensions, K_q, K_W, J_x, factorisations) for
-//! cdhrm5 at E4 and generated chains of 25, 50 and 100 universal joints (50, 100, 200 DOF),
+//! cdhrm5 at a loaded pose (E4 rounded) and generated chains of 25, 50 and 100 universal
+//! joints (50, 100, 200 DOF),
 //! and the 200-DOF decoupled chain once more with gravity and a tip wrench (non-zero,
 //! non-symmetric `K_W`). docs/performance.md has the table.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -10,20 +11,16 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use nalgebra::{Vector3, Vector6};
-use sinew_robot::{Robot, RobotData, UniformChain};
-use sinew_routing::{
-    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
-};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_stiffness::{ArmStiffness, EndSolver, joint_stiffness};
+use sinew_testkit::cdhrm5;
 
 fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
-    let chain = UniformChain::like_cdhrm5(joints);
+    let (robot, routing) = cdhrm5::chain(joints, model);
     // Weightless and unloaded: long chains cannot carry their own weight on [20, 600] N cables;
     // the cost does not depend on the load.
-    let robot = chain.build().unwrap().with_gravity(Vector3::zeros());
-    let routing =
-        Routing::new(&robot, &RoutingSpec::for_uniform_chain(&chain, model), "<bench>").unwrap();
-    (robot, routing)
+    (robot.with_gravity(Vector3::zeros()), routing)
 }
 
 fn bench_joint(c: &mut Criterion) {
@@ -55,32 +52,28 @@ fn bench_joint(c: &mut Criterion) {
 fn bench_pipeline(c: &mut Criterion) {
     let mut group = c.benchmark_group("pipeline Q -> K_x");
     group.sample_size(30);
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
-    let cdhrm5 = sinew_robot::load(dir).unwrap();
-    let pi = std::f64::consts::PI;
-    let e4 = [
-        -pi / 7.0,
-        -pi / 9.0,
-        -pi / 9.0,
-        -pi / 11.0,
-        pi / 6.0,
-        pi / 7.0,
-        pi / 8.0,
-        -pi / 15.0,
-        -pi / 12.0,
-        -pi / 10.0,
-    ];
-    for (label, file) in [("decoupled", "cables.toml"), ("routed", "cables-routed.toml")] {
-        let routing = sinew_routing::load(format!("{dir}/{file}"), &cdhrm5).unwrap();
+    let cdhrm5 = cdhrm5::robot();
+    // E4 rounded to 0.01 rad: the pose E4 itself is the facade's (`sinew::paper::E4_Q`), out of
+    // this crate's reach; the path and the cost are the same.
+    let pose = cdhrm5::LOADED_POSE;
+    for model_kind in cdhrm5::MODELS {
+        let routing = cdhrm5::routing(&cdhrm5, model_kind);
+        let label = format!("{model_kind:?}").to_lowercase();
         let model = ArmStiffness::new(&routing).unwrap();
         let mut data = model.data(&cdhrm5, &routing);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        model.evaluate(&cdhrm5, &routing, &mut data, &e4, &f0, &[0.5; 5]).unwrap();
-        group.bench_with_input(BenchmarkId::new(format!("cdhrm5 E4 {label}"), 10), &e4, |b, q| {
-            b.iter(|| {
-                model.evaluate(&cdhrm5, &routing, &mut data, black_box(q), &f0, &[0.5; 5]).unwrap()
-            })
-        });
+        model.evaluate(&cdhrm5, &routing, &mut data, &pose, &f0, &[0.5; 5]).unwrap();
+        group.bench_with_input(
+            BenchmarkId::new(format!("cdhrm5 loaded {label}"), 10),
+            &pose,
+            |b, q| {
+                b.iter(|| {
+                    model
+                        .evaluate(&cdhrm5, &routing, &mut data, black_box(q), &f0, &[0.5; 5])
+                        .unwrap()
+                })
+            },
+        );
     }
     for joints in [25, 50, 100] {
         for model_kind in [PatternModel::Decoupled, PatternModel::Routed] {

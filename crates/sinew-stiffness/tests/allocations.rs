@@ -4,61 +4,31 @@
 //!
 //! A counting global allocator (this test binary only) counts every allocation made while the
 //! per-configuration functions run.
-#![allow(clippy::unwrap_used, clippy::expect_used, unsafe_code)]
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use sinew_robot::{Robot, UniformChain};
-use sinew_routing::{PatternModel, Routing, RoutingSpec};
+use sinew_robot::Robot;
+use sinew_routing::{PatternModel, Routing};
 use sinew_stiffness::{ArmStiffness, EndSolver};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
+use sinew_testkit::{cdhrm5, config};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
-    let cdhrm5 = sinew_robot::load(ROBOT_DIR).unwrap();
     let mut v = Vec::new();
-    for (file, solver) in
-        [("cables.toml", EndSolver::Structured), ("cables-routed.toml", EndSolver::Dense)]
+    for (model, solver) in
+        [(PatternModel::Decoupled, EndSolver::Structured), (PatternModel::Routed, EndSolver::Dense)]
     {
-        let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &cdhrm5).unwrap();
-        v.push((format!("cdhrm5 {file}"), cdhrm5.clone(), routing, solver));
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        v.push((format!("cdhrm5 {}", cdhrm5::routing_file(model)), robot, routing, solver));
     }
     for (model, solver) in
         [(PatternModel::Decoupled, EndSolver::Structured), (PatternModel::Routed, EndSolver::Dense)]
     {
-        let chain = UniformChain::like_cdhrm5(25);
-        let robot = chain.build().unwrap().with_gravity(Vector3::new(0.0, 0.01, 0.0));
-        let routing =
-            Routing::new(&robot, &RoutingSpec::for_uniform_chain(&chain, model), "<test>").unwrap();
+        let (robot, routing) = cdhrm5::chain(25, model);
+        let robot = robot.with_gravity(Vector3::new(0.0, 0.01, 0.0));
         v.push((format!("uniform25 {model:?}"), robot, routing, solver));
     }
     v
@@ -66,18 +36,16 @@ fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
 
 #[test]
 fn evaluating_the_pipeline_allocates_nothing() {
+    assert_counting();
     for (name, robot, routing, solver) in arms() {
         let n = robot.dof();
         let model = ArmStiffness::new(&routing).unwrap();
         let mut data = model.data(&robot, &routing);
-        let mut rng = ChaCha8Rng::seed_from_u64(17);
-        // Around E4 for cdhrm5, around the straight arm (slightly bent) for the chain.
-        let pi = std::f64::consts::PI;
-        let e4 = [-7.0, -9.0, -9.0, -11.0, 6.0, 7.0, 8.0, -15.0, -12.0, -10.0].map(|d| pi / d);
-        let centre: Vec<f64> = if n == 10 { e4.to_vec() } else { vec![0.05; n] };
-        let qs: Vec<Vec<f64>> = (0..10)
-            .map(|_| centre.iter().map(|c| c + rng.random_range(-0.02..0.02)).collect())
-            .collect();
+        let mut rng = config::rng(17);
+        // Around a loaded pose (E4 rounded) for cdhrm5, around the straight arm (slightly bent)
+        // for the chain.
+        let centre: Vec<f64> = if n == 10 { cdhrm5::LOADED_POSE.to_vec() } else { vec![0.05; n] };
+        let qs: Vec<Vec<f64>> = (0..10).map(|_| config::near(&centre, 0.02, &mut rng)).collect();
         let levels = vec![0.5; n / 2];
         // A force and a moment (the non-symmetric structured sweep), then a pure force.
         let f = if n == 10 { 5.0 } else { 0.01 };
@@ -89,17 +57,17 @@ fn evaluating_the_pipeline_allocates_nothing() {
         model.evaluate(&robot, &routing, &mut data, &qs[0], &loads[0], &levels).unwrap();
         let _ = data.k_w();
 
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
-        for q in &qs {
-            for f0 in &loads {
-                model.evaluate(&robot, &routing, &mut data, q, f0, &levels).unwrap();
-                assert_eq!(data.end_solver(), solver, "{name}");
-                model.evaluate_compliance(&robot, &routing, &mut data, q, f0, &levels).unwrap();
-                // K_W is filled on request, into the storage kept from the last request.
-                assert!(data.k_w()[(0, 0)].is_finite());
+        let (allocations, ()) = count(|| {
+            for q in &qs {
+                for f0 in &loads {
+                    model.evaluate(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                    assert_eq!(data.end_solver(), solver, "{name}");
+                    model.evaluate_compliance(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                    // K_W is filled on request, into the storage kept from the last request.
+                    assert!(data.k_w()[(0, 0)].is_finite());
+                }
             }
-        }
-        let after = ALLOCATIONS.load(Ordering::SeqCst);
-        assert_eq!(after - before, 0, "{name}: {} allocations in 40 evaluations", after - before);
+        });
+        assert_eq!(allocations, 0, "{name}: {allocations} allocations in 40 evaluations");
     }
 }

@@ -3,11 +3,13 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use sinew_stiffness::{
     EndStiffnessData, StiffnessError, end_compliance, end_stiffness, stability_margin,
 };
+use sinew_testkit::config;
+use sinew_testkit::numeric::max_abs;
 
 fn random(rng: &mut ChaCha8Rng, r: usize, c: usize) -> Mat<f64> {
     Mat::from_fn(r, c, |_, _| rng.random_range(-1.0..1.0))
@@ -23,19 +25,9 @@ fn spd(rng: &mut ChaCha8Rng, n: usize) -> Mat<f64> {
     a
 }
 
-fn max_abs(m: &Mat<f64>) -> f64 {
-    let mut x: f64 = 0.0;
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            x = x.max(m[(i, j)].abs());
-        }
-    }
-    x
-}
-
 #[test]
 fn compliance_is_j_a_inverse_jt_and_stiffness_its_inverse() {
-    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let mut rng = config::rng(41);
     for (n, symmetric) in [(10, true), (10, false), (40, true), (40, false)] {
         let k_q = spd(&mut rng, n);
         // A small non-symmetric K_W (a base-fixed moment) keeps the symmetric part definite.
@@ -50,14 +42,18 @@ fn compliance_is_j_a_inverse_jt_and_stiffness_its_inverse() {
             faer::linalg::solvers::PartialPivLu::new(a.as_ref()).solve(j_x.transpose().to_owned());
         let expected = &j_x * &x;
         let c_x = data.compliance().to_owned();
-        let err = max_abs(&(&c_x - &expected)) / max_abs(&expected);
+        let err = max_abs((&c_x - &expected).as_ref()) / max_abs(expected.as_ref());
         assert!(err <= 1e-12, "n = {n}: C_x error {err:e}");
         let product = &c_x * data.stiffness();
         let identity = Mat::<f64>::identity(6, 6);
-        let err = max_abs(&(&product - &identity));
+        let err = max_abs((&product - &identity).as_ref());
         assert!(err <= 1e-9, "n = {n}: C_x K_x − I = {err:e}");
         if symmetric {
-            assert_eq!(max_abs(&(&c_x - c_x.transpose())), 0.0, "C_x symmetric for symmetric K");
+            assert_eq!(
+                max_abs((&c_x - c_x.transpose()).as_ref()),
+                0.0,
+                "C_x symmetric for symmetric K"
+            );
         }
         // K_fd is the top-left block of K_x; the rotations-free stiffness inverts C_x's block.
         let k_fd = data.k_fd();
@@ -74,7 +70,7 @@ fn compliance_is_j_a_inverse_jt_and_stiffness_its_inverse() {
 
 #[test]
 fn an_indefinite_joint_stiffness_is_an_unstable_equilibrium() {
-    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    let mut rng = config::rng(42);
     let n = 10;
     let mut k_q = Mat::<f64>::identity(n, n);
     k_q[(3, 3)] = -0.5;
@@ -97,7 +93,7 @@ fn an_indefinite_joint_stiffness_is_an_unstable_equilibrium() {
 
 #[test]
 fn a_rank_deficient_jacobian_is_reported_and_keeps_the_compliance() {
-    let mut rng = ChaCha8Rng::seed_from_u64(43);
+    let mut rng = config::rng(43);
     let n = 10;
     let k_q = spd(&mut rng, n);
     let k_w = Mat::zeros(n, n);
@@ -115,7 +111,7 @@ fn a_rank_deficient_jacobian_is_reported_and_keeps_the_compliance() {
 
 #[test]
 fn a_singular_translational_block_has_no_translational_stiffness() {
-    let mut rng = ChaCha8Rng::seed_from_u64(44);
+    let mut rng = config::rng(44);
     let n = 10;
     let k_q = spd(&mut rng, n);
     let k_w = Mat::zeros(n, n);

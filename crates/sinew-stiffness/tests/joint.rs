@@ -4,35 +4,12 @@
 
 use faer::Mat;
 use nalgebra::{Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use sinew_robot::{Robot, RobotData, UniformChain};
-use sinew_routing::{
-    Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
-};
+use rand::Rng;
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_stiffness::ArmStiffness;
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
-
-fn setups() -> Vec<(String, Robot, Routing)> {
-    let mut v = Vec::new();
-    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    for file in ["cables.toml", "cables-routed.toml"] {
-        let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
-        v.push((format!("cdhrm5 {file}"), robot.clone(), routing));
-    }
-    for model in [PatternModel::Decoupled, PatternModel::Routed] {
-        let chain = UniformChain::like_cdhrm5(10);
-        let robot = chain.build().unwrap();
-        let spec = RoutingSpec::for_uniform_chain(&chain, model);
-        v.push((
-            format!("uniform10 {model:?}"),
-            robot.clone(),
-            Routing::new(&robot, &spec, "<gen>").unwrap(),
-        ));
-    }
-    v
-}
+use sinew_testkit::numeric::{H, central_difference, max_abs};
+use sinew_testkit::{cdhrm5, config};
 
 /// `τ(Q) = −J_c(Q)ᵀ f(Q)` with elastic cables `f = f0 + K_l (L(Q) − L(Q0))` (spec §3).
 fn cable_torque(robot: &Robot, routing: &Routing, q: &[f64], f0: &[f64], l0: &[f64]) -> Vec<f64> {
@@ -46,31 +23,19 @@ fn cable_torque(robot: &Robot, routing: &Routing, q: &[f64], f0: &[f64], l0: &[f
     (0..robot.dof()).map(|d| -(0..f.len()).map(|c| j[(c, d)] * f[c]).sum::<f64>()).collect()
 }
 
-fn max_abs(m: faer::MatRef<'_, f64>) -> f64 {
-    let mut x: f64 = 0.0;
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            x = x.max(m[(i, j)].abs());
-        }
-    }
-    x
-}
-
 #[test]
 fn k_is_minus_the_derivative_of_the_cable_torque() {
-    const H: f64 = 1e-6;
-    for (name, robot, routing) in setups() {
+    for (name, robot, routing) in cdhrm5::cases(10) {
         let robot = robot.with_gravity(Vector3::zeros());
         let model = ArmStiffness::new(&routing).unwrap();
         let mut data = model.data(&robot, &routing);
         let n = robot.dof();
         let joints = n / 2;
-        let mut rng = ChaCha8Rng::seed_from_u64(61);
+        let mut rng = config::rng(61);
         let mut worst: f64 = 0.0;
         let mut checked = 0;
         while checked < 20 {
-            let q: Vec<f64> =
-                robot.joints().iter().map(|j| rng.random_range(j.lower..=j.upper)).collect();
+            let q: Vec<f64> = config::random_q(&robot, &mut rng);
             let levels: Vec<f64> = (0..joints).map(|_| rng.random_range(0.0..0.3)).collect();
             if model
                 .joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &levels)
@@ -81,18 +46,9 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
             checked += 1;
             let f0 = data.tensions().to_vec();
             let l0 = data.cables.lengths().unwrap().to_vec();
-            let mut numeric = Mat::<f64>::zeros(n, n);
-            for i in 0..n {
-                let mut qp = q.clone();
-                let mut qm = q.clone();
-                qp[i] += H;
-                qm[i] -= H;
-                let tp = cable_torque(&robot, &routing, &qp, &f0, &l0);
-                let tm = cable_torque(&robot, &routing, &qm, &f0, &l0);
-                for j in 0..n {
-                    numeric[(j, i)] = -(tp[j] - tm[j]) / (2.0 * H);
-                }
-            }
+            // K is restoring: minus the derivative of the cable torque.
+            let numeric =
+                -central_difference(&q, H, |q| cable_torque(&robot, &routing, q, &f0, &l0));
             let k = data.k_q();
             let err = max_abs((k.to_owned() - &numeric).as_ref()) / max_abs(k).max(1.0);
             worst = worst.max(err);
@@ -107,7 +63,7 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
 
 #[test]
 fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
-    for (name, robot, routing) in setups() {
+    for (name, robot, routing) in cdhrm5::cases(10) {
         let robot = robot.with_gravity(Vector3::zeros());
         let model = ArmStiffness::new(&routing).unwrap();
         let mut data = model.data(&robot, &routing);
@@ -140,7 +96,7 @@ fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
 #[test]
 fn the_stiffness_slope_predicts_a_change_of_tension_level() {
     // Decoupled: moving joint i's level moves only its λ; K_q is affine in it.
-    let (_, robot, routing) = setups().remove(0);
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
     let model = ArmStiffness::new(&routing).unwrap();
     let mut data = model.data(&robot, &routing);
     let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];
@@ -164,7 +120,7 @@ fn the_stiffness_slope_predicts_a_change_of_tension_level() {
 
 #[test]
 fn routed_tension_sensitivity_keeps_every_joint_balanced() {
-    let (_, robot, routing) = setups().remove(1);
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
     let model = ArmStiffness::new(&routing).unwrap();
     let mut data = model.data(&robot, &routing);
     let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];

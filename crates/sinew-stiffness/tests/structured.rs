@@ -6,18 +6,17 @@
 //! equilibria; and which solver ran.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use faer::{Mat, MatRef};
+use faer::Mat;
 use nalgebra::{Vector3, Vector6};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use sinew_robot::{Robot, RobotData, UniformChain};
-use sinew_routing::{PatternModel, Routing, RoutingSpec};
+use rand::Rng;
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{PatternModel, Routing};
 use sinew_statics::{JointEndData, equilibrium_torque_derivative};
 use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, EndSolver, EndStiffnessData, StiffnessError, end_stiffness,
 };
-
-const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
+use sinew_testkit::numeric::{max_abs, rel_diff};
+use sinew_testkit::{cdhrm5, config};
 
 /// Relative agreement required between the structured solve and the dense reference.
 const RTOL: f64 = 1e-10;
@@ -42,17 +41,8 @@ struct Setup {
     reach: f64,
 }
 
-fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
-    let chain = UniformChain::like_cdhrm5(joints);
-    let robot = chain.build().unwrap();
-    let routing =
-        Routing::new(&robot, &RoutingSpec::for_uniform_chain(&chain, model), "<test>").unwrap();
-    (robot, routing)
-}
-
 fn setups() -> Vec<Setup> {
-    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
     let mut v = vec![Setup {
         name: "cdhrm5".into(),
         robot,
@@ -64,26 +54,10 @@ fn setups() -> Vec<Setup> {
     for (joints, gravity, force, reach) in
         [(5, 9.81, 5.0, 1.0), (25, 0.05, 0.1, 0.3), (100, 0.0005, 0.01, 0.1)]
     {
-        let (robot, routing) = chain(joints, PatternModel::Decoupled);
+        let (robot, routing) = cdhrm5::chain(joints, PatternModel::Decoupled);
         v.push(Setup { name: format!("uniform{joints}"), robot, routing, gravity, force, reach });
     }
     v
-}
-
-fn max_abs(m: MatRef<'_, f64>) -> f64 {
-    let mut x: f64 = 0.0;
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            x = x.max(m[(i, j)].abs());
-        }
-    }
-    x
-}
-
-/// `max |a − b| / max |b|` (0 when both vanish).
-fn rel_err(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
-    let diff = max_abs((a.to_owned() - b).as_ref());
-    if diff == 0.0 { 0.0 } else { diff / max_abs(b) }
 }
 
 /// The dense reference at the configuration last evaluated in `data`: `K_W` from
@@ -133,14 +107,14 @@ fn compare_with_errors(
     outcome: &Result<(), StiffnessError>,
 ) -> (&'static str, f64, f64) {
     let (k_w, end, expected) = reference(robot, q, f0, data);
-    let err = rel_err(data.k_w(), k_w.as_ref());
+    let err = rel_diff(data.k_w(), k_w.as_ref());
     assert!(err <= 1e-12, "{label}: K_W from the generators off by {err:e}");
     match (outcome, &expected) {
         (Ok(()), Ok(())) => {
             assert_eq!(data.end_solver(), EndSolver::Structured, "{label}: fast path not taken");
-            let c_err = rel_err(data.compliance(), end.compliance());
+            let c_err = rel_diff(data.compliance(), end.compliance());
             assert!(c_err <= RTOL, "{label}: C_x off by {c_err:e}");
-            let k_err = rel_err(data.stiffness(), end.stiffness());
+            let k_err = rel_diff(data.stiffness(), end.stiffness());
             assert!(k_err <= RTOL, "{label}: K_x off by {k_err:e}");
             assert!(
                 data.structured_backward_error() <= 1e-14,
@@ -165,7 +139,7 @@ fn compare_with_errors(
             assert_eq!(data.end_solver(), EndSolver::Structured, "{label}: fast path not taken");
             assert!(*got <= 1e-10 && *want <= 1e-10, "{label}: pivot ratios {got:e}, {want:e}");
             // The compliance is kept, and agrees (relative to its size).
-            let err = rel_err(data.compliance(), end.compliance());
+            let err = rel_diff(data.compliance(), end.compliance());
             assert!(err <= RTOL, "{label}: C_x off by {err:e}");
             ("rank-deficient", err, 0.0)
         }
@@ -173,7 +147,7 @@ fn compare_with_errors(
     }
 }
 
-fn random_load(rng: &mut ChaCha8Rng, kind: Load, force: f64) -> Vector6<f64> {
+fn random_load(rng: &mut impl Rng, kind: Load, force: f64) -> Vector6<f64> {
     let mut f0 = Vector6::zeros();
     if kind != Load::Zero {
         for k in 0..3 {
@@ -204,7 +178,7 @@ fn the_structured_solve_matches_the_dense_reference() {
             let robot = base.with_gravity(g);
             let mut data = model.data(&robot, &routing);
             for kind in [Load::Zero, Load::Force, Load::ForceAndMoment] {
-                let mut rng = ChaCha8Rng::seed_from_u64(71 + index as u64);
+                let mut rng = config::rng(71 + index as u64);
                 let (mut checked, mut infeasible, mut stable) = (0, 0, 0);
                 let (mut worst_c, mut worst_k): (f64, f64) = (0.0, 0.0);
                 // Stable equilibria (the fast path's results) wanted, per gravity and load.
@@ -257,19 +231,18 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
     let mut stable = 0;
     for (name, robot, routing) in [
         {
-            let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
             ("cdhrm5", robot, routing)
         },
         {
-            let (robot, routing) = chain(5, PatternModel::Decoupled);
+            let (robot, routing) = cdhrm5::chain(5, PatternModel::Decoupled);
             ("uniform5", robot, routing)
         },
     ] {
         let robot = robot.with_gravity(Vector3::zeros());
         let model = ArmStiffness::new(&routing).unwrap();
         let mut data = model.data(&robot, &routing);
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut rng = config::rng(5);
         for step in 0..60 {
             let q: Vec<f64> = (0..robot.dof()).map(|_| rng.random_range(-0.05..0.05)).collect();
             let push = 2.0 * step as f64;
@@ -300,12 +273,11 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
     // rank 5 at Q = 0, C_x is singular, K_x does not exist.
     for (name, robot, routing) in [
         {
-            let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
             ("cdhrm5", robot.with_gravity(Vector3::zeros()), routing)
         },
         {
-            let (robot, routing) = chain(25, PatternModel::Decoupled);
+            let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
             ("uniform25", robot.with_gravity(Vector3::zeros()), routing)
         },
     ] {
@@ -329,24 +301,12 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
 
 #[test]
 fn the_routed_model_and_the_dense_reference_are_the_same_path() {
-    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables-routed.toml"), &robot).unwrap();
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
     let model = ArmStiffness::new(&routing).unwrap();
     let mut data = model.data(&robot, &routing);
     assert_eq!(data.end_solver(), EndSolver::NotYet);
-    let pi = std::f64::consts::PI;
-    let q = [
-        -pi / 7.0,
-        -pi / 9.0,
-        -pi / 9.0,
-        -pi / 11.0,
-        pi / 6.0,
-        pi / 7.0,
-        pi / 8.0,
-        -pi / 15.0,
-        -pi / 12.0,
-        -pi / 10.0,
-    ];
+    // A loaded pose (E4 rounded: the pose itself does not matter here, only the path).
+    let q = cdhrm5::LOADED_POSE;
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]);
     // K_q is full (a cable crosses every proximal joint): the dense path. It is exactly
@@ -356,9 +316,9 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     assert_eq!(data.k_q().to_owned(), data.k_q().transpose().to_owned());
     let (_, end, expected) = reference(&robot, &q, &f0, &data);
     assert_eq!(outcome.is_ok(), expected.is_ok());
-    assert!(rel_err(data.compliance(), end.compliance()) <= RTOL);
+    assert!(rel_diff(data.compliance(), end.compliance()) <= RTOL);
     // The decoupled routing of the same robot takes the structured path.
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     let model = ArmStiffness::new(&routing).unwrap();
     let mut data = model.data(&robot, &routing);
     model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]).unwrap();
@@ -370,12 +330,12 @@ fn k_q_outside_the_joint_blocks_stays_exactly_zero() {
     // The fast path writes only the joints' 2 × 2 blocks of the three joint-stiffness matrices;
     // the rest must stay zero across evaluations, and K_q must equal the public
     // `joint_stiffness` sum.
-    let (robot, routing) = chain(25, PatternModel::Decoupled);
+    let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
     let robot = robot.with_gravity(Vector3::new(0.0, 0.3, 0.0));
     let model = ArmStiffness::new(&routing).unwrap();
     let mut data = model.data(&robot, &routing);
     let n = robot.dof();
-    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let mut rng = config::rng(9);
     for _ in 0..10 {
         let q: Vec<f64> = (0..n).map(|_| rng.random_range(-0.1..0.1)).collect();
         let levels: Vec<f64> = (0..n / 2).map(|_| rng.random_range(0.0..1.0)).collect();
@@ -400,7 +360,7 @@ fn k_q_outside_the_joint_blocks_stays_exactly_zero() {
 fn the_generators_rebuild_k_w_and_j_x() {
     // sinew-robot's generators against its dense derivatives, and the pipeline's J_x against
     // `point_jacobian` (the same arithmetic: equal to the last bit).
-    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let mut rng = config::rng(23);
     for setup in setups() {
         let robot = &setup.robot;
         let n = robot.dof();
@@ -424,7 +384,7 @@ fn the_generators_rebuild_k_w_and_j_x() {
             let axes: Vec<Vector3<f64>> = (0..n).map(|k| *rdata.joint_axis(k).unwrap()).collect();
             let axis = |k: usize| axes[k];
             let from_generators = Mat::from_fn(n, n, |j, i| axis(i.min(j)).dot(&u[i.max(j)]));
-            let err = rel_err(from_generators.as_ref(), dense.as_ref());
+            let err = rel_diff(from_generators.as_ref(), dense.as_ref());
             assert!(err <= 1e-13, "{}: gravity generators off by {err:e}", setup.name);
             // Load: a_i · lower_j (i ≤ j), a_j · upper_i (i > j).
             let (mut upper, mut lower) = (vec![Vector3::zeros(); n], vec![Vector3::zeros(); n]);
@@ -435,7 +395,7 @@ fn the_generators_rebuild_k_w_and_j_x() {
             let from_generators = Mat::from_fn(n, n, |j, i| {
                 if i <= j { axis(i).dot(&lower[j]) } else { axis(j).dot(&upper[i]) }
             });
-            let err = rel_err(from_generators.as_ref(), dense.as_ref());
+            let err = rel_diff(from_generators.as_ref(), dense.as_ref());
             assert!(err <= 1e-13, "{}: wrench generators off by {err:e}", setup.name);
             // Partial velocities: the linear rows of the point Jacobian.
             let mut v = vec![Vector3::zeros(); n];
@@ -460,7 +420,7 @@ fn the_generators_rebuild_k_w_and_j_x() {
                     k_w.as_mut(),
                 )
                 .unwrap();
-                let err = rel_err(data.k_w(), k_w.as_ref());
+                let err = rel_diff(data.k_w(), k_w.as_ref());
                 assert!(err <= 1e-13, "{}: K_W off by {err:e}", setup.name);
             }
         }
