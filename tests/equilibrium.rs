@@ -36,8 +36,8 @@
 //! not (both sides share it: those values are checked against the paper and the URDF elsewhere).
 //!
 //! # The checks
-//! `K_x` is far from isotropic (in probe units its stiffest direction is 1e4–1e6 times stiffer
-//! than its softest), so errors are measured in wrench space, `|K_x δx − δw| / |δw|`, forces in
+//! `K_x` is far from isotropic (the cables are stiff along their length, the joints soft), so
+//! errors are measured in wrench space, `|K_x δx − δw| / |δw|`, forces in
 //! units of [`PROBE_FORCE`] and moments in units of [`PROBE_MOMENT`], column by column (one
 //! probe at a time, the worst of the six): an error along a stiff direction weighs with its
 //! stiffness instead of vanishing under the soft motion. The earlier measure
@@ -341,7 +341,7 @@ fn mat_vec(m: &Mat<f64>, v: &Vector6<f64>) -> Vector6<f64> {
 struct Checked {
     /// The stability margin, N m/rad.
     margin: f64,
-    /// The probe size relative to the full probes, `min(1, margin / 0.6 N m/rad)²`.
+    /// The probe size relative to the full probes, `size · min(1, margin / 0.6 N m/rad)²`.
     probe: f64,
     /// `|K_x δx_sym − δw| / |δw|` in probe units at `SCALES[1]`, `δx_sym = (δx(+δw) − δx(−δw)) / 2`.
     symmetric: f64,
@@ -352,7 +352,8 @@ struct Checked {
 }
 
 impl Checked {
-    /// How far the one-sided error's fall over a ten times smaller probe is from ten.
+    /// How much the one-sided error falls over a ten times smaller probe (ten when `C_x` is the
+    /// exact derivative).
     fn ratio(&self) -> f64 {
         self.one_sided[0] / self.one_sided[1]
     }
