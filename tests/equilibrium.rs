@@ -133,9 +133,9 @@ fn check(
     margin: f64,
     scale: f64,
 ) -> Option<Errors> {
-    let model = ArmStiffness::new(routing).unwrap();
-    let mut data = model.data(robot, routing);
-    model.evaluate_compliance(robot, routing, &mut data, q0, load, levels).ok()?;
+    let model = ArmStiffness::new(robot, routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
+    model.evaluate_compliance(&mut data, q0, load, levels).ok()?;
     if stability_margin(data.k_q(), data.k_w()).unwrap() < margin {
         return None;
     }
@@ -256,10 +256,10 @@ fn the_reference_is_an_equilibrium_of_the_nonlinear_model_with_gravity() {
     // The residual vanishes at the reference (the statics balanced T0 there), and it does not
     // once gravity is taken away: the nonlinear model does carry gravity.
     let (_, robot, routing) = setups().remove(0);
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
     let load = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    model.evaluate_compliance(&robot, &routing, &mut data, &E4_Q, &load, &[0.5; 5]).unwrap();
+    model.evaluate_compliance(&mut data, &E4_Q, &load, &[0.5; 5]).unwrap();
     let (f0, l0) = (data.tensions().to_vec(), data.cables.lengths().unwrap().to_vec());
     let with = Elastic { robot: &robot, routing: &routing, f0: f0.clone(), l0: l0.clone(), load };
     let r = with.residual(&E4_Q, &Vector6::zeros());

@@ -108,11 +108,11 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
             i + 1
         )));
     }
-    let arm = ArmStiffness::new(routing).map_err(CliError::input)?;
-    let mut data = arm.data(robot, routing);
+    let arm = ArmStiffness::new(robot, routing).map_err(CliError::input)?;
+    let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_column_slice(&wrench);
     let mut notes = Vec::new();
-    let outcome = arm.evaluate(robot, routing, &mut data, &q, &f0, &levels);
+    let outcome = arm.evaluate(&mut data, &q, &f0, &levels);
     let (stable, full_rank) = match outcome {
         Ok(()) => (true, true),
         Err(StiffnessError::Unstable { .. }) => {

@@ -237,10 +237,10 @@ fn library_arm(
     f0: &[f64; 6],
     levels: &[f64],
 ) -> (ArmStiffnessData, Result<(), StiffnessError>) {
-    let arm = ArmStiffness::new(routing).unwrap();
-    let mut data = arm.data(robot, routing);
+    let arm = ArmStiffness::new(robot, routing).unwrap();
+    let mut data = ArmStiffnessData::new(&arm);
     let outcome =
-        arm.evaluate(robot, routing, &mut data, q, &Vector6::from_column_slice(f0), levels);
+        arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), levels);
     (data, outcome)
 }
 

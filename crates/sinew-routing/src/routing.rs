@@ -116,6 +116,10 @@ pub struct Routing {
     pub(crate) hessian_len: usize,
     /// Largest `|dofs|` of a segment.
     pub(crate) max_span: usize,
+    /// [`Routing::dof_blocks`].
+    pub(crate) dof_blocks: Vec<Range<usize>>,
+    /// [`Routing::is_decoupled`].
+    pub(crate) decoupled: bool,
 }
 
 /// A cable after expanding either form, before it is checked against the robot.
@@ -265,7 +269,13 @@ impl Routing {
             });
         }
 
+        let dof_blocks = dof_blocks(dof, &out_cables);
+        let decoupled = out_cables
+            .iter()
+            .all(|c| c.dofs.start >= 2 * c.joint && c.dofs.end <= 2 * c.joint + 2);
         Ok(Routing {
+            dof_blocks,
+            decoupled,
             source: file,
             robot: robot.name().to_owned(),
             dof,
@@ -351,6 +361,37 @@ impl Routing {
         &self.stiffness
     }
 
+    /// The cables that drive universal joint `joint`: a range of [`Routing::cables`] (they are
+    /// ordered by joint), empty for a joint no cable drives. `O(log m)`, no allocation.
+    pub fn cables_of_joint(&self, joint: usize) -> Range<usize> {
+        let lo = self.cable_joint.partition_point(|&j| j < joint);
+        let hi = self.cable_joint.partition_point(|&j| j <= joint);
+        lo..hi
+    }
+
+    /// The universal joints whose DOFs cable `c`'s length depends on (the 2-DOF blocks of `J_c`
+    /// it spans): `J_c[c, d]` is exactly zero unless `d / 2` is in this range. `None` for no such
+    /// cable.
+    pub fn cable_joint_span(&self, c: usize) -> Option<Range<usize>> {
+        let dofs = &self.cables.get(c)?.dofs;
+        Some(dofs.start / 2..dofs.end.div_ceil(2))
+    }
+
+    /// Whether every cable changes length with the DOFs of the joint it drives only (the
+    /// decoupled model): `J_c` and the joint stiffness are then block diagonal, one 2 × 2 block
+    /// per universal joint at most.
+    pub fn is_decoupled(&self) -> bool {
+        self.decoupled
+    }
+
+    /// The DOF blocks of the routing: the finest partition of `0..dof` into consecutive ranges
+    /// that no cable's DOFs straddle, so that the joint stiffness `Σ f_c H_c + J_cᵀ K_l J_c` is
+    /// block diagonal over them with exact zeros elsewhere. Decoupled: one block per universal
+    /// joint; routed: one block of every DOF a cable of the last joint crosses.
+    pub fn dof_blocks(&self) -> &[Range<usize>] {
+        &self.dof_blocks
+    }
+
     /// Index of a cable by name.
     pub fn cable_index(&self, name: &str) -> Option<usize> {
         self.cables.iter().position(|c| c.name == name)
@@ -412,6 +453,25 @@ pub fn load(path: impl AsRef<Path>, robot: &Robot) -> Result<Routing> {
     let text = std::fs::read_to_string(&path)
         .map_err(|source| RoutingError::Io { path: path.clone(), source })?;
     Routing::from_toml_str(&text, &path.display().to_string(), robot)
+}
+
+/// [`Routing::dof_blocks`] of cables over `dof` DOFs.
+fn dof_blocks(dof: usize, cables: &[Cable]) -> Vec<Range<usize>> {
+    // joined[d]: DOFs d − 1 and d are in one block.
+    let mut joined = vec![false; dof];
+    for cable in cables {
+        for d in cable.dofs.start + 1..cable.dofs.end.min(dof) {
+            joined[d] = true;
+        }
+    }
+    let mut blocks: Vec<Range<usize>> = Vec::new();
+    for d in 0..dof {
+        match blocks.last_mut() {
+            Some(block) if joined[d] => block.end = d + 1,
+            _ => blocks.push(d..d + 1),
+        }
+    }
+    blocks
 }
 
 pub(crate) fn check_shape(

@@ -29,6 +29,14 @@ pub struct ArmStaticsData {
     pub tensions: Vec<f64>,
 }
 
+impl ArmStaticsData {
+    /// The joint-end statics of the last solve: `K_W`'s generators and `J_x`, computed with
+    /// `T0` in one pass ([`equilibrium_torques`]).
+    pub fn joint_end(&self) -> &JointEndData {
+        &self.joint_end
+    }
+}
+
 impl ArmStatics {
     /// Check the routing against the solver (see [`CableLayout::new`]).
     ///

@@ -72,29 +72,29 @@ fn bench_pipeline(c: &mut Criterion) {
     ];
     for (label, file) in [("decoupled", "cables.toml"), ("routed", "cables-routed.toml")] {
         let routing = sinew_routing::load(format!("{dir}/{file}"), &cdhrm5).unwrap();
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&cdhrm5, &routing);
+        let model = ArmStiffness::new(&cdhrm5, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        model.evaluate(&cdhrm5, &routing, &mut data, &e4, &f0, &[0.5; 5]).unwrap();
+        model.evaluate(&mut data, &e4, &f0, &[0.5; 5]).unwrap();
         group.bench_with_input(BenchmarkId::new(format!("cdhrm5 E4 {label}"), 10), &e4, |b, q| {
             b.iter(|| {
-                model.evaluate(&cdhrm5, &routing, &mut data, black_box(q), &f0, &[0.5; 5]).unwrap()
+                model.evaluate(&mut data, black_box(q), &f0, &[0.5; 5]).unwrap()
             })
         });
     }
     for joints in [25, 50, 100] {
         for model_kind in [PatternModel::Decoupled, PatternModel::Routed] {
             let (robot, routing) = chain(joints, model_kind);
-            let model = ArmStiffness::new(&routing).unwrap();
-            let mut data = model.data(&robot, &routing);
+            let model = ArmStiffness::new(&robot, &routing).unwrap();
+            let mut data = ArmStiffnessData::new(&model);
             let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
             let levels = vec![0.1; joints];
             let f0 = Vector6::zeros();
-            model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+            model.evaluate(&mut data, &q, &f0, &levels).unwrap();
             let label = format!("uniform {model_kind:?}").to_lowercase();
             group.bench_with_input(BenchmarkId::new(label, 2 * joints), &q, |b, q| {
                 b.iter(|| {
-                    model.evaluate(&robot, &routing, &mut data, black_box(q), &f0, &levels).unwrap()
+                    model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap()
                 })
             });
         }
@@ -104,16 +104,16 @@ fn bench_pipeline(c: &mut Criterion) {
     {
         let (robot, routing) = chain(100, PatternModel::Decoupled);
         let robot = robot.with_gravity(Vector3::new(0.0, 5e-4, 0.0));
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
         let levels = vec![0.1; 100];
         let f0 = Vector6::new(0.0, 0.005, 0.0, 0.0, 0.0, 0.0005);
-        model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        model.evaluate(&mut data, &q, &f0, &levels).unwrap();
         assert_eq!(data.end_solver(), EndSolver::Structured);
         group.bench_with_input(BenchmarkId::new("uniform decoupled loaded", 200), &q, |b, q| {
             b.iter(|| {
-                model.evaluate(&robot, &routing, &mut data, black_box(q), &f0, &levels).unwrap()
+                model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap()
             })
         });
     }

@@ -24,7 +24,8 @@ use nalgebra::Matrix2;
 use sinew_routing::{Routing, RoutingData, SegmentHessians};
 
 use crate::error::StiffnessError;
-use crate::structured::{BlockLayout, ColMajor, MAX_BLOCK, zero_blocks};
+use crate::colmajor::ColMajor;
+use crate::structured::{BlockLayout, MAX_BLOCK, zero_blocks};
 
 fn check(what: &'static str, m: &MatMut<'_, f64>, n: usize) -> Result<(), StiffnessError> {
     for got in [m.nrows(), m.ncols()] {

@@ -14,7 +14,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sinew_robot::{Robot, UniformChain};
 use sinew_routing::{PatternModel, Routing, RoutingSpec};
-use sinew_stiffness::{ArmStiffness, EndSolver};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver};
 
 struct Counting;
 
@@ -68,8 +68,8 @@ fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
 fn evaluating_the_pipeline_allocates_nothing() {
     for (name, robot, routing, solver) in arms() {
         let n = robot.dof();
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let mut rng = ChaCha8Rng::seed_from_u64(17);
         // Around E4 for cdhrm5, around the straight arm (slightly bent) for the chain.
         let pi = std::f64::consts::PI;
@@ -86,15 +86,15 @@ fn evaluating_the_pipeline_allocates_nothing() {
             Vector6::new(0.0, f, 0.0, 0.0, 0.0, 0.0),
         ];
         // Warm-up: the first evaluation and the first request of K_W.
-        model.evaluate(&robot, &routing, &mut data, &qs[0], &loads[0], &levels).unwrap();
+        model.evaluate(&mut data, &qs[0], &loads[0], &levels).unwrap();
         let _ = data.k_w();
 
         let before = ALLOCATIONS.load(Ordering::SeqCst);
         for q in &qs {
             for f0 in &loads {
-                model.evaluate(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                model.evaluate(&mut data, q, f0, &levels).unwrap();
                 assert_eq!(data.end_solver(), solver, "{name}");
-                model.evaluate_compliance(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                model.evaluate_compliance(&mut data, q, f0, &levels).unwrap();
                 // K_W is filled on request, into the storage kept from the last request.
                 assert!(data.k_w()[(0, 0)].is_finite());
             }
