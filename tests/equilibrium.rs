@@ -18,7 +18,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sinew::robot::{Robot, RobotData};
 use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
-use sinew::stiffness::{ArmStiffness, stability_margin};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 
 const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
 
@@ -136,7 +136,7 @@ fn check(
     let model = ArmStiffness::new(robot, routing).unwrap();
     let mut data = ArmStiffnessData::new(&model);
     model.evaluate_compliance(&mut data, q0, load, levels).ok()?;
-    if stability_margin(data.k_q(), data.k_w()).unwrap() < margin {
+    if data.stability_margin().unwrap() < margin {
         return None;
     }
     let c_x = data.compliance().to_owned();

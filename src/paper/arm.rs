@@ -10,7 +10,7 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 use crate::indicators::StiffnessEllipsoid;
 use crate::robot::Robot;
 use crate::routing::Routing;
-use crate::stiffness::{ArmStiffness, StiffnessError, stability_margin};
+use crate::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use super::claims::Claim;
 use super::{E4_F0, E4_Q, fixed};
@@ -111,7 +111,7 @@ pub fn e4(
         match arm.joint_level(&mut data, &E4_Q, &f0, &levels) {
             Err(e) => case.failure = Some(format!("infeasible: {e}")),
             Ok(()) => {
-                case.margin = Some(stability_margin(data.k_q(), data.k_w())?);
+                case.margin = Some(data.stability_margin()?);
                 match arm.evaluate(&mut data, &E4_Q, &f0, &levels) {
                     Ok(()) => {
                         let k = data.k_fd();

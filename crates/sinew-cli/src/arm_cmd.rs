@@ -3,7 +3,7 @@
 use nalgebra::Vector6;
 use serde::Serialize;
 use sinew::indicators::StiffnessEllipsoid;
-use sinew::stiffness::{ArmStiffness, StiffnessError, stability_margin};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use crate::cli::ArmArgs;
 use crate::error::{CliError, model_error};
@@ -129,7 +129,7 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         }
         Err(e) => return Err(model_error(e)),
     };
-    let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(model_error)?;
+    let min_eigenvalue = data.stability_margin().map_err(model_error)?;
     let c_x = stable.then(|| faer_rows(data.compliance()));
     // (C_x[0:3, 0:3])⁻¹: None where that block is singular (same tolerance as K_x's).
     let k_translational = if stable { data.translational_stiffness() } else { None };
