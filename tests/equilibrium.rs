@@ -163,7 +163,7 @@ fn check(
 
 fn setups() -> Vec<(&'static str, Robot, Routing)> {
     let robot = sinew::robot::load(ROBOT_DIR).unwrap();
-    ["cables.toml", "cables-routed.toml"]
+    [sinew::routing::ROUTING_FILE, sinew::routing::ROUTED_ROUTING_FILE]
         .into_iter()
         .map(|file| {
             let routing = sinew::routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();

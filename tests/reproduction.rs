@@ -82,8 +82,11 @@ fn snapshots_are_identical_across_runs() {
 #[test]
 fn fig_6_e4_decoupled_and_routed() {
     let (robot, routing) = cdhrm5();
-    let routed =
-        sinew::routing::load(root().join("robots/cdhrm5/cables-routed.toml"), &robot).unwrap();
+    let routed = sinew::routing::load(
+        root().join("robots/cdhrm5").join(sinew::routing::ROUTED_ROUTING_FILE),
+        &robot,
+    )
+    .unwrap();
     let decoupled = paper::e4(&robot, &routing, "decoupled", 0.0).unwrap();
     let routed = paper::e4(&robot, &routed, "routed", 0.0).unwrap();
     let baseline = paper::e4(&robot, &routing, "decoupled", 0.25).unwrap();

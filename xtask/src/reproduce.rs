@@ -92,7 +92,7 @@ fn write_report(root: &Path, dir: PathBuf) -> DynResult<Vec<PathBuf>> {
     let e2 = paper::e2(&robot, &routing, E2_SAMPLES)?;
     let e3 = paper::e3(&robot, &routing, FIG5_POINTS)?;
     let claims = paper::claims_e1_e3(&table_2, &e2, &e3);
-    let routed = sinew::routing::load(robot_dir.join("cables-routed.toml"), &robot)?;
+    let routed = sinew::routing::load(robot_dir.join(sinew::routing::ROUTED_ROUTING_FILE), &robot)?;
     let e4 = [
         paper::e4(&robot, &routing, "decoupled", 0.0)?,
         paper::e4(&robot, &routed, "routed", 0.0)?,

@@ -38,8 +38,11 @@ impl Fixture {
             }
         }
         let robot = sinew::robot::load(dir.path()).unwrap();
-        let routing = sinew::routing::load(dir.path().join("cables.toml"), &robot).unwrap();
-        let routed = sinew::routing::load(dir.path().join("cables-routed.toml"), &robot).unwrap();
+        let routing =
+            sinew::routing::load(dir.path().join(sinew::routing::ROUTING_FILE), &robot).unwrap();
+        let routed =
+            sinew::routing::load(dir.path().join(sinew::routing::ROUTED_ROUTING_FILE), &robot)
+                .unwrap();
         Fixture { dir, robot, routing, routed }
     }
 
@@ -239,8 +242,7 @@ fn library_arm(
 ) -> (ArmStiffnessData, Result<(), StiffnessError>) {
     let arm = ArmStiffness::new(robot, routing).unwrap();
     let mut data = ArmStiffnessData::new(&arm);
-    let outcome =
-        arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), levels);
+    let outcome = arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), levels);
     (data, outcome)
 }
 
@@ -622,11 +624,11 @@ fn a_robot_folder_without_its_files_is_named() {
     assert_fails(&["routing", "--robot", g], 2, &["does not exist", g]);
     // A folder without the routing file of the model asked for.
     let fx = Fixture::new();
-    std::fs::remove_file(fx.dir.path().join("cables-routed.toml")).unwrap();
+    std::fs::remove_file(fx.dir.path().join(sinew::routing::ROUTED_ROUTING_FILE)).unwrap();
     assert_fails(
         &["routing", "--robot", fx.path(), "--model", "routed"],
         2,
-        &["cables-routed.toml"],
+        &[sinew::routing::ROUTED_ROUTING_FILE],
     );
 }
 

@@ -106,17 +106,12 @@ impl JointProbe {
         if joint >= joints {
             return Err(IndicatorError::NoSuchJoint { joint, joints });
         }
-        let own: Vec<usize> =
-            (0..routing.cable_count()).filter(|&c| routing.cable_joints()[c] == joint).collect();
-        let first_cable = own.first().copied().unwrap_or(0);
-        if own.len() != 3 || own[2] != first_cable + 2 {
-            return Err(sinew_statics::StaticsError::UnsupportedRouting {
-                reason: format!(
-                    "joint {} has {} cables; the single-joint model needs its own three",
-                    joint + 1,
-                    own.len()
-                ),
-            }
+        let own = routing.cables_of_joint(joint);
+        let first_cable = own.start;
+        if own.len() != 3 {
+            return Err(sinew_statics::StaticsError::UnsupportedRouting(
+                sinew_statics::UnsupportedRouting::JointCables { joint, cables: own.len() },
+            )
             .into());
         }
         let [f_min, f_max] = routing.tension_limits();

@@ -331,8 +331,14 @@ fn load_and_evaluate(robot: &Robot, text: &str) {
 /// The valid files the mutations start from: both cdhrm5 files and an explicit one.
 fn valid_files() -> Vec<String> {
     vec![
-        std::fs::read_to_string(format!("{}/cables.toml", common::CDHRM5)).unwrap(),
-        std::fs::read_to_string(format!("{}/cables-routed.toml", common::CDHRM5)).unwrap(),
+        std::fs::read_to_string(format!("{}/{}", common::CDHRM5, sinew_routing::ROUTING_FILE))
+            .unwrap(),
+        std::fs::read_to_string(format!(
+            "{}/{}",
+            common::CDHRM5,
+            sinew_routing::ROUTED_ROUTING_FILE
+        ))
+        .unwrap(),
         explicit(GOOD_CABLE),
     ]
 }

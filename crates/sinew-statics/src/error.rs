@@ -1,5 +1,7 @@
 //! The one error type of this crate.
 
+use sinew_robot::Compact;
+
 /// Why a joint's cables cannot hold its torque.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -34,7 +36,78 @@ impl std::fmt::Display for InfeasibleReason {
             ),
             InfeasibleReason::OutsideLimits { lambda_min, lambda_max } => write!(
                 f,
-                "no tensions within the limits hold the torque (λ ≥ {lambda_min:.4} and λ ≤ {lambda_max:.4})"
+                "no tensions within the limits hold the torque (λ ≥ {} and λ ≤ {})",
+                Compact(*lambda_min),
+                Compact(*lambda_max)
+            ),
+        }
+    }
+}
+
+/// Why a routing does not fit the closed-form statics: three cables per universal joint, in
+/// joint order, none changing length with a joint beyond its own.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum UnsupportedRouting {
+    /// An odd number of revolute joints: not a chain of 2-DOF universal joints.
+    OddDof {
+        /// The number of revolute joints.
+        dof: usize,
+    },
+    /// Not three cables per joint.
+    CableCount {
+        /// The number of cables.
+        cables: usize,
+        /// The number of universal joints.
+        joints: usize,
+    },
+    /// A joint that does not own exactly three cables, consecutive in the routing.
+    JointCables {
+        /// Universal joint index (0-based).
+        joint: usize,
+        /// The number of cables that drive it.
+        cables: usize,
+    },
+    /// A cable out of joint order.
+    CableOrder {
+        /// The cable.
+        cable: String,
+        /// The joint it drives (0-based).
+        joint: usize,
+    },
+    /// A cable whose length changes with a joint beyond the one it drives.
+    BeyondOwnJoint {
+        /// The cable.
+        cable: String,
+        /// The joint it drives (0-based).
+        joint: usize,
+    },
+}
+
+impl std::fmt::Display for UnsupportedRouting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            UnsupportedRouting::OddDof { dof } => {
+                write!(f, "{dof} DOF is not a chain of 2-DOF universal joints")
+            }
+            UnsupportedRouting::CableCount { cables, joints } => write!(
+                f,
+                "{cables} cables for {joints} joints; the closed-form solver needs 3 per joint"
+            ),
+            UnsupportedRouting::JointCables { joint, cables } => write!(
+                f,
+                "joint {} has {cables} cables; the single-joint model needs its own three",
+                joint + 1
+            ),
+            UnsupportedRouting::CableOrder { cable, joint } => write!(
+                f,
+                "cable `{cable}` drives joint {}; expected 3 cables per joint, in joint order",
+                joint + 1
+            ),
+            UnsupportedRouting::BeyondOwnJoint { cable, joint } => write!(
+                f,
+                "cable `{cable}` of joint {} changes length with joints beyond its own",
+                joint + 1
             ),
         }
     }
@@ -46,7 +119,7 @@ impl std::fmt::Display for InfeasibleReason {
 pub enum StaticsError {
     /// A joint's cables cannot hold its torque within the tension limits: the typed outcome of
     /// an infeasible load.
-    #[error("joint {} cannot hold torque [{:.4}, {:.4}] N m with tensions in [{}, {}] N: {reason}", .joint + 1, .torque[0], .torque[1], .limits[0], .limits[1])]
+    #[error("joint {} cannot hold torque [{}, {}] N m with tensions in [{}, {}] N: {reason}", .joint + 1, Compact(.torque[0]), Compact(.torque[1]), Compact(.limits[0]), Compact(.limits[1]))]
     Infeasible {
         /// Universal joint index (0-based; the message counts from 1, as the paper does).
         joint: usize,
@@ -58,7 +131,7 @@ pub enum StaticsError {
         reason: InfeasibleReason,
     },
     /// A torque with a NaN or infinite component.
-    #[error("joint {}: torque [{}, {}] is not finite", .joint + 1, .torque[0], .torque[1])]
+    #[error("joint {}: torque [{}, {}] is not finite", .joint + 1, Compact(.torque[0]), Compact(.torque[1]))]
     NonFiniteTorque {
         /// Universal joint index (0-based).
         joint: usize,
@@ -66,7 +139,7 @@ pub enum StaticsError {
         torque: [f64; 2],
     },
     /// A tension level outside `[0, 1]` (or NaN).
-    #[error("joint {}: tension level {level} is outside [0, 1]", .joint + 1)]
+    #[error("joint {}: tension level {} is outside [0, 1]", .joint + 1, Compact(*.level))]
     InvalidLevel {
         /// Universal joint index (0-based).
         joint: usize,
@@ -74,11 +147,8 @@ pub enum StaticsError {
         level: f64,
     },
     /// A routing that is not three cables per universal joint (each cable driving one joint).
-    #[error("unsupported routing: {reason}")]
-    UnsupportedRouting {
-        /// What does not fit.
-        reason: String,
-    },
+    #[error("unsupported routing: {0}")]
+    UnsupportedRouting(UnsupportedRouting),
     /// An input of the wrong size.
     #[error("{what}: expected {expected} entries, got {got}")]
     DimensionMismatch {

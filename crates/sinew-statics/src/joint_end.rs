@@ -184,10 +184,9 @@ pub fn equilibrium_torques(
 ) -> Result<(), StaticsError> {
     check_wrench(f0)?;
     let n = robot.dof();
-    for (what, expected, got) in [
-        ("equilibrium torques T0", n, t0.len()),
-        ("joint-end workspace", n, data.j_x.len()),
-    ] {
+    for (what, expected, got) in
+        [("equilibrium torques T0", n, t0.len()), ("joint-end workspace", n, data.j_x.len())]
+    {
         if expected != got {
             return Err(StaticsError::DimensionMismatch { what, expected, got });
         }

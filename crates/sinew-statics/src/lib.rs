@@ -22,7 +22,7 @@ mod joint_end;
 
 pub use arm::{ArmStatics, ArmStaticsData};
 pub use distribution::{CableLayout, distribute_tensions};
-pub use error::{InfeasibleReason, StaticsError};
+pub use error::{InfeasibleReason, StaticsError, UnsupportedRouting};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,
     tension_interval,

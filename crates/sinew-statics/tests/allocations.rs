@@ -39,7 +39,7 @@ static GLOBAL: Counting = Counting;
 fn solving_the_statics_allocates_nothing() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");
     let robot = sinew_robot::load(dir).unwrap();
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew_routing::ROUTING_FILE, sinew_routing::ROUTED_ROUTING_FILE] {
         let routing = sinew_routing::load(format!("{dir}/{file}"), &robot).unwrap();
         let statics = ArmStatics::new(&routing).unwrap();
         let mut rdata = RobotData::new(&robot);

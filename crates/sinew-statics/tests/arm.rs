@@ -25,7 +25,7 @@ fn cdhrm5(file: &str) -> (Robot, Routing) {
 
 fn setups() -> Vec<(String, Robot, Routing)> {
     let mut v = Vec::new();
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew_routing::ROUTING_FILE, sinew_routing::ROUTED_ROUTING_FILE] {
         let (robot, routing) = cdhrm5(file);
         v.push((format!("cdhrm5 {file}"), robot, routing));
     }
@@ -106,7 +106,7 @@ fn every_level_balances_t0_at_random_configurations_and_loads() {
 
 /// One joint's 3 × 2 cable Jacobian block of cdhrm5's first joint at `q` (decoupled).
 fn joint_block(q: [f64; 2]) -> Matrix3x2<f64> {
-    let (robot, routing) = cdhrm5("cables.toml");
+    let (robot, routing) = cdhrm5(sinew_routing::ROUTING_FILE);
     let mut full = vec![0.0; 10];
     full[0] = q[0];
     full[1] = q[1];
@@ -143,7 +143,7 @@ fn e2_is_feasible() {
 
 #[test]
 fn e4_under_the_documented_mounting() {
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew_routing::ROUTING_FILE, sinew_routing::ROUTED_ROUTING_FILE] {
         let (robot, routing) = cdhrm5(file);
         let statics = ArmStatics::new(&routing).unwrap();
         let mut rdata = RobotData::new(&robot);
@@ -168,7 +168,7 @@ fn e4_under_the_documented_mounting() {
 
 #[test]
 fn a_load_that_cannot_be_held_names_the_first_joint_that_fails() {
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew_routing::ROUTING_FILE, sinew_routing::ROUTED_ROUTING_FILE] {
         let (robot, routing) = cdhrm5(file);
         let statics = ArmStatics::new(&routing).unwrap();
         let mut rdata = RobotData::new(&robot);
@@ -183,7 +183,7 @@ fn a_load_that_cannot_be_held_names_the_first_joint_that_fails() {
         assert!(matches!(reason, InfeasibleReason::OutsideLimits { .. }));
         // Decoupled: solved from the base, joint 1 fails first. Routed: solved from the tip,
         // the most distal joint that cannot hold its share fails first.
-        if file == "cables.toml" {
+        if file == sinew_routing::ROUTING_FILE {
             assert_eq!(joint, 0);
         }
     }

@@ -70,16 +70,16 @@ fn bench_pipeline(c: &mut Criterion) {
         -pi / 12.0,
         -pi / 10.0,
     ];
-    for (label, file) in [("decoupled", "cables.toml"), ("routed", "cables-routed.toml")] {
+    for (label, file) in
+        [("decoupled", sinew_routing::ROUTING_FILE), ("routed", sinew_routing::ROUTED_ROUTING_FILE)]
+    {
         let routing = sinew_routing::load(format!("{dir}/{file}"), &cdhrm5).unwrap();
         let model = ArmStiffness::new(&cdhrm5, &routing).unwrap();
         let mut data = ArmStiffnessData::new(&model);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
         model.evaluate(&mut data, &e4, &f0, &[0.5; 5]).unwrap();
         group.bench_with_input(BenchmarkId::new(format!("cdhrm5 E4 {label}"), 10), &e4, |b, q| {
-            b.iter(|| {
-                model.evaluate(&mut data, black_box(q), &f0, &[0.5; 5]).unwrap()
-            })
+            b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &[0.5; 5]).unwrap())
         });
     }
     for joints in [25, 50, 100] {
@@ -93,9 +93,7 @@ fn bench_pipeline(c: &mut Criterion) {
             model.evaluate(&mut data, &q, &f0, &levels).unwrap();
             let label = format!("uniform {model_kind:?}").to_lowercase();
             group.bench_with_input(BenchmarkId::new(label, 2 * joints), &q, |b, q| {
-                b.iter(|| {
-                    model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap()
-                })
+                b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
             });
         }
     }
@@ -112,9 +110,7 @@ fn bench_pipeline(c: &mut Criterion) {
         model.evaluate(&mut data, &q, &f0, &levels).unwrap();
         assert_eq!(data.end_solver(), EndSolver::Structured);
         group.bench_with_input(BenchmarkId::new("uniform decoupled loaded", 200), &q, |b, q| {
-            b.iter(|| {
-                model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap()
-            })
+            b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
         });
     }
     group.finish();

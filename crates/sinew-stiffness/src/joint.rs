@@ -23,8 +23,8 @@ use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
 use sinew_routing::{Routing, RoutingData, SegmentHessians};
 
-use crate::error::StiffnessError;
 use crate::colmajor::ColMajor;
+use crate::error::StiffnessError;
 use crate::structured::{BlockLayout, MAX_BLOCK, zero_blocks};
 
 fn check(what: &'static str, m: &MatMut<'_, f64>, n: usize) -> Result<(), StiffnessError> {

@@ -46,9 +46,10 @@ const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm
 fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
     let cdhrm5 = sinew_robot::load(ROBOT_DIR).unwrap();
     let mut v = Vec::new();
-    for (file, solver) in
-        [("cables.toml", EndSolver::Structured), ("cables-routed.toml", EndSolver::Dense)]
-    {
+    for (file, solver) in [
+        (sinew_routing::ROUTING_FILE, EndSolver::Structured),
+        (sinew_routing::ROUTED_ROUTING_FILE, EndSolver::Dense),
+    ] {
         let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &cdhrm5).unwrap();
         v.push((format!("cdhrm5 {file}"), cdhrm5.clone(), routing, solver));
     }

@@ -17,7 +17,7 @@ const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm
 fn setups() -> Vec<(String, Robot, Routing)> {
     let mut v = Vec::new();
     let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew_routing::ROUTING_FILE, sinew_routing::ROUTED_ROUTING_FILE] {
         let routing = sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
         v.push((format!("cdhrm5 {file}"), robot.clone(), routing));
     }
@@ -72,10 +72,7 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
             let q: Vec<f64> =
                 robot.joints().iter().map(|j| rng.random_range(j.lower..=j.upper)).collect();
             let levels: Vec<f64> = (0..joints).map(|_| rng.random_range(0.0..0.3)).collect();
-            if model
-                .joint_level(&mut data, &q, &Vector6::zeros(), &levels)
-                .is_err()
-            {
+            if model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).is_err() {
                 continue;
             }
             checked += 1;
@@ -113,9 +110,7 @@ fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
         let mut data = ArmStiffnessData::new(&model);
         let n = robot.dof();
         let q: Vec<f64> = (0..n).map(|i| 0.1 * ((i as f64) * 1.7).sin()).collect();
-        model
-            .joint_level(&mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2])
-            .unwrap();
+        model.joint_level(&mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2]).unwrap();
         let k = data.k_q();
         let mut off_block: f64 = 0.0;
         for j in 0..n {

@@ -51,7 +51,9 @@ fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
 
 fn setups() -> Vec<Setup> {
     let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let routing =
+        sinew_routing::load(format!("{ROBOT_DIR}/{}", sinew_routing::ROUTING_FILE), &robot)
+            .unwrap();
     let mut v = vec![Setup {
         name: "cdhrm5".into(),
         robot,
@@ -260,7 +262,9 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
     for (name, robot, routing) in [
         {
             let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            let routing =
+                sinew_routing::load(format!("{ROBOT_DIR}/{}", sinew_routing::ROUTING_FILE), &robot)
+                    .unwrap();
             ("cdhrm5", robot, routing)
         },
         {
@@ -284,7 +288,8 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
                 if let Err(StiffnessError::Statics(_)) = outcome {
                     continue;
                 }
-                match compare(&format!("{name} push {push}"), &robot, &q, &f0, &mut data, &outcome) {
+                match compare(&format!("{name} push {push}"), &robot, &q, &f0, &mut data, &outcome)
+                {
                     "unstable" => unstable += 1,
                     "stable" => stable += 1,
                     _ => {}
@@ -303,7 +308,9 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
     for (name, robot, routing) in [
         {
             let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-            let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+            let routing =
+                sinew_routing::load(format!("{ROBOT_DIR}/{}", sinew_routing::ROUTING_FILE), &robot)
+                    .unwrap();
             ("cdhrm5", robot.with_gravity(Vector3::zeros()), routing)
         },
         {
@@ -332,7 +339,9 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
 #[test]
 fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     let robot = sinew_robot::load(ROBOT_DIR).unwrap();
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables-routed.toml"), &robot).unwrap();
+    let routing =
+        sinew_routing::load(format!("{ROBOT_DIR}/{}", sinew_routing::ROUTED_ROUTING_FILE), &robot)
+            .unwrap();
     let model = ArmStiffness::new(&robot, &routing).unwrap();
     let mut data = ArmStiffnessData::new(&model);
     assert_eq!(data.end_solver(), EndSolver::NotYet);
@@ -360,7 +369,9 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     assert_eq!(outcome.is_ok(), expected.is_ok());
     assert!(rel_err(data.compliance(), end.compliance()) <= RTOL);
     // The decoupled routing of the same robot takes the structured path.
-    let routing = sinew_routing::load(format!("{ROBOT_DIR}/cables.toml"), &robot).unwrap();
+    let routing =
+        sinew_routing::load(format!("{ROBOT_DIR}/{}", sinew_routing::ROUTING_FILE), &robot)
+            .unwrap();
     let model = ArmStiffness::new(&robot, &routing).unwrap();
     let mut data = ArmStiffnessData::new(&model);
     model.evaluate(&mut data, &q, &f0, &[0.5; 5]).unwrap();

@@ -18,8 +18,8 @@ pub fn cdhrm5() -> Robot {
 /// The platform's routing: `cables.toml` (decoupled) or `cables-routed.toml`.
 pub fn cdhrm5_routing(robot: &Robot, model: PatternModel) -> Routing {
     let file = match model {
-        PatternModel::Decoupled => "cables.toml",
-        PatternModel::Routed => "cables-routed.toml",
+        PatternModel::Decoupled => sinew_routing::ROUTING_FILE,
+        PatternModel::Routed => sinew_routing::ROUTED_ROUTING_FILE,
     };
     sinew_routing::load(format!("{CDHRM5}/{file}"), robot).unwrap()
 }

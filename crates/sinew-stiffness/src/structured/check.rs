@@ -83,7 +83,10 @@ pub(crate) fn check(layout: &BlockLayout, gens: &KwGenerators, data: &mut Struct
     let rho = &mut data.x;
     for (block, factor) in layout.blocks().zip(&data.factors) {
         let start = block.start;
-        dispatch!(block.len(), check_block(factor, gens.is_symmetric(), start, gens, &mut acc, rho));
+        dispatch!(
+            block.len(),
+            check_block(factor, gens.is_symmetric(), start, gens, &mut acc, rho)
+        );
     }
     let mut r_max: f64 = 0.0;
     for (j, rho_j) in rho.iter().enumerate() {
