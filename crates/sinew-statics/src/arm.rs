@@ -69,6 +69,8 @@ impl ArmStatics {
             null: Vector3::zeros(),
             lambda_min: 0.0,
             lambda_max: 0.0,
+            limits: self.limits,
+            limiting: [0, 0],
         };
         ArmStaticsData {
             joint_end: JointEndData::new(robot),

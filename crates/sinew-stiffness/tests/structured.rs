@@ -471,3 +471,25 @@ fn the_generators_rebuild_k_w_and_j_x() {
         }
     }
 }
+
+#[test]
+fn a_workspace_made_for_another_arm_is_a_typed_mismatch() {
+    let robot = sinew_robot::load(ROBOT_DIR).unwrap();
+    let load = |file: &str| sinew_routing::load(format!("{ROBOT_DIR}/{file}"), &robot).unwrap();
+    let decoupled = ArmStiffness::new(&robot, &load(sinew_routing::ROUTING_FILE)).unwrap();
+    let routed = ArmStiffness::new(&robot, &load(sinew_routing::ROUTED_ROUTING_FILE)).unwrap();
+    let (chain_robot, chain_routing) = chain(10, PatternModel::Decoupled);
+    let longer = ArmStiffness::new(&chain_robot, &chain_routing).unwrap();
+    let mut data = ArmStiffnessData::new(&decoupled);
+    let (q, f0, levels) = ([0.1; 10], Vector6::zeros(), [0.5; 5]);
+    decoupled.evaluate(&mut data, &q, &f0, &levels).unwrap();
+    assert!(decoupled.check(&data).is_ok());
+    for arm in [&routed, &longer] {
+        assert!(matches!(arm.check(&data), Err(StiffnessError::WorkspaceMismatch { .. })));
+        let err = arm.evaluate(&mut data, &q, &f0, &levels).unwrap_err();
+        assert!(matches!(err, StiffnessError::WorkspaceMismatch { .. }), "{err:?}");
+    }
+    // A routing built for another robot is refused when the model is made.
+    let err = ArmStiffness::new(&chain_robot, &load(sinew_routing::ROUTING_FILE)).unwrap_err();
+    assert!(matches!(err, StiffnessError::Routing(_)), "{err:?}");
+}
