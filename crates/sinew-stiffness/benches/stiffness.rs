@@ -14,7 +14,7 @@ use sinew_robot::{Robot, RobotData, UniformChain};
 use sinew_routing::{
     Order, PatternModel, Routing, RoutingData, RoutingSpec, compute_cable_geometry,
 };
-use sinew_stiffness::{ArmStiffness, EndSolver, joint_stiffness};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver, joint_stiffness};
 
 fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
     let chain = UniformChain::like_cdhrm5(joints);
