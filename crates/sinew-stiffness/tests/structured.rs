@@ -482,7 +482,7 @@ fn a_workspace_made_for_another_arm_is_a_typed_mismatch() {
     let longer = ArmStiffness::new(&chain_robot, &chain_routing).unwrap();
     let mut data = ArmStiffnessData::new(&decoupled);
     let (q, f0, levels) = ([0.1; 10], Vector6::zeros(), [0.5; 5]);
-    decoupled.evaluate(&mut data, &q, &f0, &levels).unwrap();
+    decoupled.joint_level(&mut data, &q, &f0, &levels).unwrap();
     assert!(decoupled.check(&data).is_ok());
     for arm in [&routed, &longer] {
         assert!(matches!(arm.check(&data), Err(StiffnessError::WorkspaceMismatch { .. })));
