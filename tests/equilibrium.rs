@@ -66,7 +66,7 @@ use rand_chacha::ChaCha8Rng;
 use sinew::robot::{Robot, RobotData};
 use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
 use sinew::statics::StaticsError;
-use sinew::stiffness::{ArmStiffness, StiffnessError, stability_margin};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use sinew::paper::E4_Q;
 
@@ -120,9 +120,9 @@ fn linearise(
     load: &Vector6<f64>,
     levels: &[f64],
 ) -> Option<Linear> {
-    let model = ArmStiffness::new(routing).unwrap();
-    let mut data = model.data(robot, routing);
-    match model.evaluate(robot, routing, &mut data, q, load, levels) {
+    let model = ArmStiffness::new(robot, routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
+    match model.evaluate(&mut data, q, load, levels) {
         Ok(()) => {}
         Err(
             StiffnessError::Unstable { .. }
@@ -133,7 +133,7 @@ fn linearise(
     Some(Linear {
         c_x: data.compliance().to_owned(),
         k_x: data.stiffness().to_owned(),
-        margin: stability_margin(data.k_q(), data.k_w()).unwrap(),
+        margin: data.stability_margin().unwrap(),
         tensions: data.tensions().to_vec(),
     })
 }

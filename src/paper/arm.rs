@@ -10,7 +10,7 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 use crate::indicators::StiffnessEllipsoid;
 use crate::robot::Robot;
 use crate::routing::Routing;
-use crate::stiffness::{ArmStiffness, StiffnessError, stability_margin};
+use crate::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use super::claims::Claim;
 use super::experiments::{E4_CASES, E4_F0, E4_Q};
@@ -80,11 +80,11 @@ pub fn e4(
     model: &str,
     baseline: f64,
 ) -> Result<E4, crate::Error> {
-    let arm = ArmStiffness::new(routing)?;
-    let mut data = arm.data(robot, routing);
+    let arm = ArmStiffness::new(robot, routing)?;
+    let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_row_slice(&E4_F0);
     let mut joints = Vec::new();
-    let lowest = arm.joint_level(robot, routing, &mut data, &E4_Q, &f0, &[0.0; 5]);
+    let lowest = arm.joint_level(&mut data, &E4_Q, &f0, &[0.0; 5]);
     // T0 is computed before the tensions, so it is there even when they are infeasible.
     let t0 = data.statics.t0.clone();
     if lowest.is_ok() {
@@ -95,7 +95,7 @@ pub fn e4(
         for i in 0..5 {
             let mut levels = [0.0; 5];
             levels[i] = 1.0;
-            let high = match arm.joint_level(robot, routing, &mut data, &E4_Q, &f0, &levels) {
+            let high = match arm.joint_level(&mut data, &E4_Q, &f0, &levels) {
                 Ok(()) => data.joint_stiffness(i).map_or([f64::NAN; 2], |k| [k[(0, 0)], k[(1, 1)]]),
                 Err(_) => [f64::NAN; 2],
             };
@@ -111,11 +111,11 @@ pub fn e4(
     for (name, raised) in E4_CASES {
         let levels = raised.map(|r| if r { 1.0 } else { baseline });
         let mut case = E4Case { name, levels, margin: None, k_fd: None, failure: None };
-        match arm.joint_level(robot, routing, &mut data, &E4_Q, &f0, &levels) {
+        match arm.joint_level(&mut data, &E4_Q, &f0, &levels) {
             Err(e) => case.failure = Some(format!("infeasible: {e}")),
             Ok(()) => {
-                case.margin = Some(stability_margin(data.k_q(), data.k_w())?);
-                match arm.evaluate(robot, routing, &mut data, &E4_Q, &f0, &levels) {
+                case.margin = Some(data.stability_margin()?);
+                match arm.evaluate(&mut data, &E4_Q, &f0, &levels) {
                     Ok(()) => {
                         let k = data.k_fd();
                         case.k_fd = Some((k, StiffnessEllipsoid::new(&k)?));

@@ -30,9 +30,7 @@ pub use patterns::{
     LEAST_RANGE_AWAY, MAX_RISE, MAX_RISE_OVER_MIN_MOVE, NEAR_ZERO_MAX, NEAR_ZERO_SHARE,
     WIDER_Q2_NEGATIVE, WIDER_Q2_POSITIVE, table_2_patterns,
 };
-pub use report::{
-    FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, ROUTED_FILE, Report,
-};
+pub use report::{FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, Report};
 pub use single_joint::{
     E2Point, Table2Row, e2, e2_csv, e3, e3_csv, e3_with_progress, render_table_2,
     rms_relative_error, table_2,

@@ -20,8 +20,6 @@ use super::table1::table_1;
 
 /// The robot folder of the report, relative to the workspace root.
 pub const ROBOT_DIR: &str = "robots/cdhrm5";
-/// The routed model's routing file in [`ROBOT_DIR`] (the decoupled one is the default).
-pub const ROUTED_FILE: &str = "cables-routed.toml";
 /// Where the report is committed, relative to the workspace root.
 pub const REPORT_DIR: &str = "docs/reproduction";
 
@@ -73,7 +71,7 @@ pub struct Report {
     pub robot: Robot,
     /// Its default (decoupled) routing.
     pub routing: Routing,
-    /// Its routed routing ([`ROUTED_FILE`]).
+    /// Its routed routing ([`crate::routing::ROUTED_ROUTING_FILE`]).
     pub routed: Routing,
     /// Table I, rendered (markdown).
     pub table_1: String,
@@ -105,7 +103,7 @@ const E4_RUNS: [(&str, &str); 3] = [
 
 impl Report {
     /// Compute every table, data set and claim from a robot folder (`robot.toml`, its URDF,
-    /// `cables.toml` and [`ROUTED_FILE`]).
+    /// [`crate::routing::ROUTING_FILE`] and [`crate::routing::ROUTED_ROUTING_FILE`]).
     ///
     /// # Errors
     /// A file that cannot be read or a routing the experiments cannot handle; infeasible or
@@ -125,7 +123,8 @@ impl Report {
     ) -> Result<Report, crate::Error> {
         let robot = crate::robot::load(robot_dir)?;
         let routing = crate::routing::load(robot_dir, &robot)?;
-        let routed = crate::routing::load(robot_dir.join(ROUTED_FILE), &robot)?;
+        let routed =
+            crate::routing::load(robot_dir.join(crate::routing::ROUTED_ROUTING_FILE), &robot)?;
         let table_1 = table_1(robot_dir)?;
         let table_2 = table_2(&robot, &routing)?;
         let e2 = e2(&robot, &routing, E2_SAMPLES)?;

@@ -633,8 +633,8 @@ fn file_texts(g: &Geometry) -> DynResult<[(&'static str, String); 3]> {
     };
     Ok([
         ("cdhrm5.urdf", chain.to_urdf()),
-        ("cables.toml", decoupled_toml(&values)),
-        ("cables-routed.toml", routed_toml(&values)),
+        (sinew::routing::ROUTING_FILE, decoupled_toml(&values)),
+        (sinew::routing::ROUTED_ROUTING_FILE, routed_toml(&values)),
     ])
 }
 
@@ -659,7 +659,7 @@ fn compare_with_files(dir: &Path, g: &Geometry) -> DynResult<Vec<String>> {
     };
     compare("d1 (cdhrm5.urdf)", d1, g.d1, CHECK_LENGTH, false);
     compare("d2 (cdhrm5.urdf)", d2, g.d2, CHECK_LENGTH, false);
-    for file in ["cables.toml", "cables-routed.toml"] {
+    for file in [sinew::routing::ROUTING_FILE, sinew::routing::ROUTED_ROUTING_FILE] {
         let text = std::fs::read_to_string(dir.join(file))?;
         let spec = RoutingSpec::from_toml_str(&text, file)?;
         let pattern = spec.pattern.as_ref().ok_or_else(|| format!("{file}: no [pattern]"))?;

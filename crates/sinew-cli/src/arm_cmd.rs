@@ -3,7 +3,7 @@
 use nalgebra::Vector6;
 use serde::Serialize;
 use sinew::indicators::StiffnessEllipsoid;
-use sinew::stiffness::{ArmStiffness, StiffnessError, stability_margin};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use crate::cli::ArmArgs;
 use crate::error::{CliError, library_error};
@@ -103,11 +103,11 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         None => vec![0.0; joints],
     };
     // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
-    let arm = ArmStiffness::new(routing).map_err(library_error)?;
-    let mut data = arm.data(robot, routing);
+    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
+    let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_column_slice(&wrench);
     let mut notes = Vec::new();
-    let outcome = arm.evaluate(robot, routing, &mut data, &q, &f0, &levels);
+    let outcome = arm.evaluate(&mut data, &q, &f0, &levels);
     let (stable, full_rank) = match outcome {
         Ok(()) => (true, true),
         Err(StiffnessError::Unstable { .. }) => {
@@ -124,7 +124,7 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         }
         Err(e) => return Err(library_error(e)),
     };
-    let min_eigenvalue = stability_margin(data.k_q(), data.k_w()).map_err(library_error)?;
+    let min_eigenvalue = data.stability_margin().map_err(library_error)?;
     let c_x = stable.then(|| faer_rows(data.compliance()));
     // (C_x[0:3, 0:3])⁻¹: None where that block is singular (same tolerance as K_x's).
     let k_translational = if stable { data.translational_stiffness() } else { None };

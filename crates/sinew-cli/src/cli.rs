@@ -63,8 +63,8 @@ impl Model {
     /// The routing file's name in a robot folder.
     pub fn file_name(self) -> &'static str {
         match self {
-            Model::Decoupled => "cables.toml",
-            Model::Routed => "cables-routed.toml",
+            Model::Decoupled => sinew::routing::ROUTING_FILE,
+            Model::Routed => sinew::routing::ROUTED_ROUTING_FILE,
         }
     }
 

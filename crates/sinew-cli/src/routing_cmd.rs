@@ -1,29 +1,27 @@
 //! `sinew routing`: the expanded cable routing and the robot's joints.
 
 use serde::Serialize;
-use sinew::routing::RoutingModel;
+use sinew::routing::{RoutingModel, RoutingView};
 
 use crate::cli::RoutingArgs;
 use crate::error::CliError;
 use crate::input::{Loaded, load};
 use crate::output::{Fmt, Table, emit, print_json};
 
-/// The JSON document of `sinew routing`.
+/// The JSON document of `sinew routing`: the robot's files and joints, then the library's
+/// view of the routing ([`sinew::routing::Routing::view`], flattened: `robot`, `source`,
+/// `model`, `youngs_modulus`, `area`, `tension_limits`, `cables`).
 #[derive(Debug, Serialize)]
 struct RoutingOut<'a> {
     command: &'static str,
-    robot: &'a str,
     robot_dir: String,
     urdf: String,
     tip_link: &'a str,
     gravity: [f64; 3],
     routing_file: String,
-    model: RoutingModel,
-    youngs_modulus: f64,
-    area: f64,
-    tension_limits: [f64; 2],
     joints: Vec<JointOut<'a>>,
-    cables: Vec<CableOut<'a>>,
+    #[serde(flatten)]
+    routing: RoutingView<'a>,
 }
 
 /// A revolute joint.
@@ -40,27 +38,6 @@ struct JointOut<'a> {
     upper: f64,
 }
 
-/// A cable.
-#[derive(Debug, Serialize)]
-struct CableOut<'a> {
-    name: &'a str,
-    joint: usize,
-    holes: Vec<HoleOut<'a>>,
-    free_length: f64,
-    routed_length: f64,
-    elastic_length: f64,
-    stiffness: f64,
-    f_min: f64,
-    f_max: f64,
-}
-
-/// A hole: a point in a link's frame.
-#[derive(Debug, Serialize)]
-struct HoleOut<'a> {
-    link: &'a str,
-    point: [f64; 3],
-}
-
 /// Run `sinew routing`.
 pub fn run(args: &RoutingArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, false)?;
@@ -71,19 +48,13 @@ pub fn run(args: &RoutingArgs) -> Result<(), CliError> {
 fn document(loaded: &Loaded) -> RoutingOut<'_> {
     let Loaded { description, robot, routing, routing_file } = loaded;
     let g = robot.gravity();
-    let [f_min, f_max] = routing.tension_limits();
     RoutingOut {
         command: "routing",
-        robot: robot.name(),
         robot_dir: description.dir.display().to_string(),
         urdf: description.urdf.display().to_string(),
         tip_link: &description.settings.tip_link,
         gravity: [g.x, g.y, g.z],
         routing_file: routing_file.display().to_string(),
-        model: routing.model(),
-        youngs_modulus: routing.youngs_modulus(),
-        area: routing.area(),
-        tension_limits: routing.tension_limits(),
         joints: robot
             .joints()
             .iter()
@@ -97,38 +68,20 @@ fn document(loaded: &Loaded) -> RoutingOut<'_> {
                 upper: j.upper,
             })
             .collect(),
-        cables: routing
-            .cables()
-            .iter()
-            .map(|c| CableOut {
-                name: &c.name,
-                joint: c.joint,
-                holes: c
-                    .holes
-                    .iter()
-                    .map(|h| HoleOut { link: &h.link, point: [h.point.x, h.point.y, h.point.z] })
-                    .collect(),
-                free_length: c.free_length,
-                routed_length: c.routed_length,
-                elastic_length: c.elastic_length,
-                stiffness: c.stiffness,
-                f_min,
-                f_max,
-            })
-            .collect(),
+        routing: routing.view(),
     }
 }
 
 fn render(out: &RoutingOut<'_>) -> String {
     let mut s = String::new();
-    let model = match out.model {
+    let model = match out.routing.model {
         RoutingModel::Decoupled => "decoupled",
         RoutingModel::Routed => "routed",
         RoutingModel::Explicit => "explicit (hole by hole)",
     };
     s.push_str(&format!(
         "robot `{}`: {}\n  tip link `{}`, gravity {} m/s² (base frame)\n",
-        out.robot,
+        out.routing.robot,
         out.urdf,
         out.tip_link,
         Fmt::Fixed(3).list(&out.gravity)
@@ -136,11 +89,11 @@ fn render(out: &RoutingOut<'_>) -> String {
     s.push_str(&format!(
         "routing: {} ({model}), {} cables\n  E = {} Pa, A = {} m², tensions in [{}, {}] N\n\n",
         out.routing_file,
-        out.cables.len(),
-        Fmt::Sci(4).num(out.youngs_modulus),
-        Fmt::Sci(4).num(out.area),
-        out.tension_limits[0],
-        out.tension_limits[1]
+        out.routing.cables.len(),
+        Fmt::Sci(4).num(out.routing.youngs_modulus),
+        Fmt::Sci(4).num(out.routing.area),
+        out.routing.tension_limits[0],
+        out.routing.tension_limits[1]
     ));
     s.push_str("Revolute joints, base first (universal joints numbered from 1), limits in rad:\n");
     let mut joints = Table::new(&["q", "name", "joint", "axis", "lower", "upper"]).left(&[1]);
@@ -161,7 +114,7 @@ fn render(out: &RoutingOut<'_>) -> String {
     let mut cables =
         Table::new(&["cable", "joint", "k = EA/l (N/m)", "l (m)", "hole", "link", "x", "y", "z"])
             .left(&[5]);
-    for c in &out.cables {
+    for c in &out.routing.cables {
         for (k, h) in c.holes.iter().enumerate() {
             let mut cells = if k == 0 {
                 vec![

@@ -15,7 +15,7 @@ use sinew::indicators::{AngleGrid, JointProbe, StiffnessEllipsoid, sweep_joint};
 use sinew::paper::{E4_F0, E4_Q, e3_csv};
 use sinew::robot::{Robot, RobotDescription};
 use sinew::routing::Routing;
-use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError, stability_margin};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 use tempfile::TempDir;
 
 /// A private copy of cdhrm5, loaded through the library.
@@ -36,8 +36,11 @@ impl Fixture {
             }
         }
         let robot = sinew::robot::load(dir.path()).unwrap();
-        let routing = sinew::routing::load(dir.path().join("cables.toml"), &robot).unwrap();
-        let routed = sinew::routing::load(dir.path().join("cables-routed.toml"), &robot).unwrap();
+        let routing =
+            sinew::routing::load(dir.path().join(sinew::routing::ROUTING_FILE), &robot).unwrap();
+        let routed =
+            sinew::routing::load(dir.path().join(sinew::routing::ROUTED_ROUTING_FILE), &robot)
+                .unwrap();
         Fixture { dir, robot, routing, routed }
     }
 
@@ -235,14 +238,13 @@ fn library_arm(
     f0: &[f64; 6],
     levels: &[f64],
 ) -> (ArmStiffnessData, Result<(), StiffnessError>) {
-    let arm = ArmStiffness::new(routing).unwrap();
-    let mut data = arm.data(robot, routing);
-    let outcome =
-        arm.evaluate(robot, routing, &mut data, q, &Vector6::from_column_slice(f0), levels);
+    let arm = ArmStiffness::new(robot, routing).unwrap();
+    let mut data = ArmStiffnessData::new(&arm);
+    let outcome = arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), levels);
     (data, outcome)
 }
 
-fn check_arm(doc: &Value, data: &ArmStiffnessData, outcome: &Result<(), StiffnessError>) {
+fn check_arm(doc: &Value, data: &mut ArmStiffnessData, outcome: &Result<(), StiffnessError>) {
     assert_eq!(doc["command"], "arm");
     assert_vec(&doc["t0"], &data.statics.t0, "t0");
     assert_vec(&doc["tensions"], data.tensions(), "tensions");
@@ -251,7 +253,7 @@ fn check_arm(doc: &Value, data: &ArmStiffnessData, outcome: &Result<(), Stiffnes
     assert_faer(&doc["k_controllable"], data.k_controllable(), "k_controllable");
     assert_faer(&doc["k_inherent"], data.k_inherent(), "k_inherent");
     assert_faer(&doc["j_x"], data.j_x(), "j_x");
-    let margin = stability_margin(data.k_q(), data.k_w()).unwrap();
+    let margin = data.stability_margin().unwrap();
     assert_num(&doc["min_eigenvalue"], margin, "min_eigenvalue");
     for (k, (iv, lib)) in
         doc["intervals"].as_array().unwrap().iter().zip(data.intervals()).enumerate()
@@ -315,8 +317,8 @@ fn arm_json_equals_the_library_at_e4() {
     let (q, f0, s) = (list(&E4_Q), list(&E4_F0), list(&levels));
     let doc =
         json(&["arm", "--robot", fx.path(), "--q", &q, "--wrench", &f0, "--levels", &s, "--json"]);
-    let (data, outcome) = library_arm(&fx.robot, &fx.routing, &E4_Q, &E4_F0, &levels);
-    check_arm(&doc, &data, &outcome);
+    let (mut data, outcome) = library_arm(&fx.robot, &fx.routing, &E4_Q, &E4_F0, &levels);
+    check_arm(&doc, &mut data, &outcome);
     assert_vec(&doc["q"], &E4_Q, "q");
     assert_vec(&doc["wrench"], &E4_F0, "wrench");
     assert_vec(&doc["levels"], &levels, "levels");
@@ -328,8 +330,8 @@ fn arm_defaults_routed_and_no_gravity_equal_the_library() {
     let q = list(&E4_Q);
     // Defaults: zero wrench, every level 0, gravity on, decoupled.
     let doc = json(&["arm", "--robot", fx.path(), "--q", &q, "--json"]);
-    let (data, outcome) = library_arm(&fx.robot, &fx.routing, &E4_Q, &[0.0; 6], &[0.0; 5]);
-    check_arm(&doc, &data, &outcome);
+    let (mut data, outcome) = library_arm(&fx.robot, &fx.routing, &E4_Q, &[0.0; 6], &[0.0; 5]);
+    check_arm(&doc, &mut data, &outcome);
     // Routed, gravity off, a load and mixed levels.
     let levels = [0.2, 0.4, 1.0, 0.0, 0.7];
     let (f0, s) = ([0.0, 2.0, 0.0, 0.0, 0.0, 0.1], list(&levels));
@@ -350,8 +352,8 @@ fn arm_defaults_routed_and_no_gravity_equal_the_library() {
         "--json",
     ]);
     let weightless = fx.robot.with_gravity(Vector3::zeros());
-    let (data, outcome) = library_arm(&weightless, &fx.routed, &E4_Q, &f0, &levels);
-    check_arm(&doc, &data, &outcome);
+    let (mut data, outcome) = library_arm(&weightless, &fx.routed, &E4_Q, &f0, &levels);
+    check_arm(&doc, &mut data, &outcome);
     assert_vec(&doc["gravity"], &[0.0; 3], "gravity");
     assert_eq!(doc["model"], "routed");
 }
@@ -375,7 +377,7 @@ fn an_unstable_equilibrium_is_a_result_with_null_end_stiffness() {
     let weightless = fx.robot.with_gravity(Vector3::zeros());
     let q = [0.0; 10];
     let f0 = [0.0, 0.0, 50.0, 0.0, 0.0, 0.0];
-    let (data, outcome) = library_arm(&weightless, &fx.routing, &q, &f0, &[0.0; 5]);
+    let (mut data, outcome) = library_arm(&weightless, &fx.routing, &q, &f0, &[0.0; 5]);
     assert!(
         matches!(outcome, Err(StiffnessError::Unstable { .. })),
         "precondition: the library finds this load unstable ({outcome:?})"
@@ -383,7 +385,7 @@ fn an_unstable_equilibrium_is_a_result_with_null_end_stiffness() {
     let (qs, fs) = (list(&q), list(&f0));
     let args = ["arm", "--robot", fx.path(), "--q", &qs, "--wrench", &fs, "--no-gravity"];
     let doc = json(&[&args[..], &["--json"]].concat());
-    check_arm(&doc, &data, &outcome);
+    check_arm(&doc, &mut data, &outcome);
     assert!(num(&doc["min_eigenvalue"]) < 0.0);
     // The tables say so too, with exit 0.
     let out = run(&args);
@@ -399,7 +401,7 @@ fn a_rank_deficient_jacobian_reports_the_compliance_only() {
     let weightless = fx.robot.with_gravity(Vector3::zeros());
     let q = [0.0; 10];
     let f0 = [0.0, 0.0, -50.0, 0.0, 0.0, 0.0];
-    let (data, outcome) = library_arm(&weightless, &fx.routing, &q, &f0, &[0.0; 5]);
+    let (mut data, outcome) = library_arm(&weightless, &fx.routing, &q, &f0, &[0.0; 5]);
     assert!(
         matches!(outcome, Err(StiffnessError::RankDeficient { .. })),
         "precondition: rank-deficient J_x ({outcome:?})"
@@ -407,7 +409,7 @@ fn a_rank_deficient_jacobian_reports_the_compliance_only() {
     let (qs, fs) = (list(&q), list(&f0));
     let doc =
         json(&["arm", "--robot", fx.path(), "--q", &qs, "--wrench", &fs, "--no-gravity", "--json"]);
-    check_arm(&doc, &data, &outcome);
+    check_arm(&doc, &mut data, &outcome);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -620,11 +622,11 @@ fn a_robot_folder_without_its_files_is_named() {
     assert_fails(&["routing", "--robot", g], 2, &["does not exist", g]);
     // A folder without the routing file of the model asked for.
     let fx = Fixture::new();
-    std::fs::remove_file(fx.dir.path().join("cables-routed.toml")).unwrap();
+    std::fs::remove_file(fx.dir.path().join(sinew::routing::ROUTED_ROUTING_FILE)).unwrap();
     assert_fails(
         &["routing", "--robot", fx.path(), "--model", "routed"],
         2,
-        &["cables-routed.toml"],
+        &[sinew::routing::ROUTED_ROUTING_FILE],
     );
 }
 
@@ -857,7 +859,8 @@ fn any_universal_joint_axes_load_and_are_named() {
     // An oblique axis in the disc plane: loads, computes, and is named.
     let fx = with_second_axis("0.6 0.8 0");
     let robot = sinew::robot::load(fx.dir.path()).unwrap();
-    let routing = sinew::routing::load(fx.dir.path().join("cables.toml"), &robot).unwrap();
+    let routing =
+        sinew::routing::load(fx.dir.path().join(sinew::routing::ROUTING_FILE), &robot).unwrap();
     let args =
         ["joint", "--robot", fx.path(), "--joint", "2", "--q", "0.1,-0.2", "--torque", "0.3,0.3"];
     let doc = json(&[&args[..], &["--json"]].concat());

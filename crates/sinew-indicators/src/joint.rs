@@ -122,10 +122,9 @@ impl JointProbe {
         if joint >= joints {
             return Err(IndicatorError::NoSuchJoint { joint, joints });
         }
-        let own: Vec<usize> =
-            (0..routing.cable_count()).filter(|&c| routing.cable_joints()[c] == joint).collect();
-        let first_cable = own.first().copied().unwrap_or(0);
-        if own.len() != 3 || own[2] != first_cable + 2 {
+        let own = routing.cables_of_joint(joint);
+        let first_cable = own.start;
+        if own.len() != 3 {
             return Err(IndicatorError::NotThreeCables { joint, cables: own.len() });
         }
         let [f_min, f_max] = routing.tension_limits();

@@ -9,7 +9,7 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 use sinew_indicators::{JointProbe, StiffnessEllipsoid};
-use sinew_stiffness::ArmStiffness;
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 use sinew_testkit::{cdhrm5, config};
 
@@ -83,10 +83,10 @@ fn an_infeasible_probe_allocates_nothing() {
 fn the_ellipsoid_allocates_nothing() {
     // K_fd: the translational block of K_x at a loaded pose of cdhrm5 (and a made-up matrix).
     let (robot, routing) = cdhrm5::robot_and_routing(cdhrm5::MODELS[0]);
-    let arm = ArmStiffness::new(&routing).unwrap();
-    let mut data = arm.data(&robot, &routing);
+    let arm = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    arm.evaluate(&robot, &routing, &mut data, &cdhrm5::LOADED_POSE, &f0, &[0.5; 5]).unwrap();
+    arm.evaluate(&mut data, &cdhrm5::LOADED_POSE, &f0, &[0.5; 5]).unwrap();
     let k_x = data.stiffness();
     let k_fd = Matrix3::from_fn(|r, c| k_x[(r, c)]);
     let other = Matrix3::new(3.0, 0.5, 0.0, 0.5, 2.0, 0.1, 0.0, 0.1, 1.0);

@@ -37,6 +37,29 @@ impl Robot {
         }
     }
 
+    /// The mass moments `r_j = Σ_{b > j} m_b (c_b − p_j)` (base frame, kg m): of everything
+    /// joint `j` moves, about its pivot `p_j` (module docs), into `out` (length dof). With them
+    /// `T_g[j] = −g · (a_j × r_j)` and the generators `u_j = g × (a_j × r_j)`: sinew-statics
+    /// forms `T0`, `∂T0/∂Q`'s generators and `J_x` from them in one pass.
+    ///
+    /// Needs [`Robot::forward_kinematics`] first. `O(dof)`, no allocation.
+    ///
+    /// # Errors
+    /// [`RobotError::WorkspaceMismatch`], [`RobotError::DimensionMismatch`].
+    pub fn mass_moments(&self, data: &mut RobotData, out: &mut [Vector3<f64>]) -> Result<()> {
+        data.check(self)?;
+        if out.len() != self.dof() {
+            return Err(RobotError::DimensionMismatch {
+                what: "mass moments",
+                expected: self.dof(),
+                got: out.len(),
+            });
+        }
+        self.accumulate_mass_moments(data);
+        out.copy_from_slice(&data.o_mass_moment);
+        Ok(())
+    }
+
     /// `T_g(Q)`: the joint torques that hold the links against gravity, `∂V/∂Q` (N m).
     ///
     /// Needs [`Robot::forward_kinematics`] first; `out` has length dof.

@@ -54,6 +54,7 @@ pub use geometry::{
     compute_cable_geometry_from_kinematics,
 };
 pub use routing::{
-    Cable, Hole, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment, load,
+    Cable, CableView, Hole, HoleView, MIN_SEGMENT_LENGTH, ROUTED_ROUTING_FILE, ROUTING_FILE,
+    Routing, RoutingModel, RoutingView, Segment, load, routing_file,
 };
 pub use spec::{ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec};

@@ -357,8 +357,8 @@ fn load_and_evaluate(robot: &Robot, text: &str) {
 /// The valid files the mutations start from: both cdhrm5 files and an explicit one.
 fn valid_files() -> Vec<String> {
     vec![
-        std::fs::read_to_string(cdhrm5::dir().join("cables.toml")).unwrap(),
-        std::fs::read_to_string(cdhrm5::dir().join("cables-routed.toml")).unwrap(),
+        std::fs::read_to_string(cdhrm5::dir().join(sinew_routing::ROUTING_FILE)).unwrap(),
+        std::fs::read_to_string(cdhrm5::dir().join(sinew_routing::ROUTED_ROUTING_FILE)).unwrap(),
         explicit(GOOD_CABLE),
     ]
 }

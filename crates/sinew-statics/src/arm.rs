@@ -29,6 +29,14 @@ pub struct ArmStaticsData {
     pub tensions: Vec<f64>,
 }
 
+impl ArmStaticsData {
+    /// The joint-end statics of the last solve: `K_W`'s generators and `J_x`, computed with
+    /// `T0` in one pass ([`equilibrium_torques`]).
+    pub fn joint_end(&self) -> &JointEndData {
+        &self.joint_end
+    }
+}
+
 impl ArmStatics {
     /// Check the routing against the solver (see [`CableLayout::new`]).
     ///
@@ -61,6 +69,8 @@ impl ArmStatics {
             null: Vector3::zeros(),
             lambda_min: 0.0,
             lambda_max: 0.0,
+            limits: self.limits,
+            limiting: [0, 0],
         };
         ArmStaticsData {
             joint_end: JointEndData::new(robot),

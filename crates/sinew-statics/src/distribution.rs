@@ -17,7 +17,7 @@ use faer::MatRef;
 use nalgebra::{Matrix3x2, Vector2};
 use sinew_routing::Routing;
 
-use crate::error::StaticsError;
+use crate::error::{StaticsError, UnsupportedRouting};
 use crate::interval::{TensionInterval, TensionLimits, tension_interval};
 
 /// How the cables of a routing map onto the joints: three per universal joint.
@@ -29,44 +29,45 @@ pub struct CableLayout {
 
 impl CableLayout {
     /// Check that a routing fits the closed-form solver: 2n DOF, three cables per universal
-    /// joint in joint order, none whose length depends on a joint beyond its own. Records
-    /// whether some cable also crosses proximal joints (the routed model).
+    /// joint in joint order ([`Routing::cables_of_joint`]), none whose length depends on a
+    /// joint beyond its own ([`Routing::cable_joint_span`]). Records whether some cable also
+    /// crosses proximal joints (the routed model: not [`Routing::is_decoupled`]).
     ///
     /// # Errors
     /// [`StaticsError::UnsupportedRouting`] saying what does not fit.
     pub fn new(routing: &Routing) -> Result<CableLayout, StaticsError> {
-        let unsupported = |reason: String| StaticsError::UnsupportedRouting { reason };
+        let unsupported = |why| Err(StaticsError::UnsupportedRouting(why));
         let dof = routing.dof();
         if !dof.is_multiple_of(2) {
-            return Err(unsupported(format!("{dof} DOF is not a chain of 2-DOF universal joints")));
+            return unsupported(UnsupportedRouting::OddDof { dof });
         }
         let joints = dof / 2;
         let cables = routing.cables();
         if cables.len() != 3 * joints {
-            return Err(unsupported(format!(
-                "{} cables for {joints} joints; the closed-form solver needs 3 per joint",
-                cables.len()
-            )));
+            return unsupported(UnsupportedRouting::CableCount { cables: cables.len(), joints });
         }
-        let mut crossing = false;
+        for joint in 0..joints {
+            if routing.cables_of_joint(joint) != (3 * joint..3 * joint + 3) {
+                // Three per joint in all, so some cable is out of joint order.
+                let c = (0..cables.len()).find(|&c| cables[c].joint != c / 3).unwrap_or(0);
+                let cable = cables[c].name.clone();
+                return unsupported(UnsupportedRouting::CableOrder {
+                    cable,
+                    joint: cables[c].joint,
+                });
+            }
+        }
         for (c, cable) in cables.iter().enumerate() {
-            if cable.joint != c / 3 {
-                return Err(unsupported(format!(
-                    "cable `{}` drives joint {}; expected 3 cables per joint, in joint order",
-                    cable.name,
-                    cable.joint + 1
-                )));
+            let beyond = routing.cable_joint_span(c).is_some_and(|span| span.end > cable.joint + 1);
+            if beyond {
+                let name = cable.name.clone();
+                return unsupported(UnsupportedRouting::BeyondOwnJoint {
+                    cable: name,
+                    joint: cable.joint,
+                });
             }
-            if cable.dofs.end > 2 * cable.joint + 2 {
-                return Err(unsupported(format!(
-                    "cable `{}` of joint {} changes length with joints beyond its own",
-                    cable.name,
-                    cable.joint + 1
-                )));
-            }
-            crossing |= cable.dofs.start < 2 * cable.joint;
         }
-        Ok(CableLayout { joints, crossing })
+        Ok(CableLayout { joints, crossing: !routing.is_decoupled() })
     }
 
     /// Number of universal joints.

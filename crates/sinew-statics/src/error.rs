@@ -46,6 +46,75 @@ impl std::fmt::Display for InfeasibleReason {
     }
 }
 
+/// Why a routing does not fit the closed-form statics: three cables per universal joint, in
+/// joint order, none changing length with a joint beyond its own.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum UnsupportedRouting {
+    /// An odd number of revolute joints: not a chain of 2-DOF universal joints.
+    OddDof {
+        /// The number of revolute joints.
+        dof: usize,
+    },
+    /// Not three cables per joint.
+    CableCount {
+        /// The number of cables.
+        cables: usize,
+        /// The number of universal joints.
+        joints: usize,
+    },
+    /// A joint that does not own exactly three cables, consecutive in the routing.
+    JointCables {
+        /// Universal joint index (0-based).
+        joint: usize,
+        /// The number of cables that drive it.
+        cables: usize,
+    },
+    /// A cable out of joint order.
+    CableOrder {
+        /// The cable.
+        cable: String,
+        /// The joint it drives (0-based).
+        joint: usize,
+    },
+    /// A cable whose length changes with a joint beyond the one it drives.
+    BeyondOwnJoint {
+        /// The cable.
+        cable: String,
+        /// The joint it drives (0-based).
+        joint: usize,
+    },
+}
+
+impl std::fmt::Display for UnsupportedRouting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            UnsupportedRouting::OddDof { dof } => {
+                write!(f, "{dof} DOF is not a chain of 2-DOF universal joints")
+            }
+            UnsupportedRouting::CableCount { cables, joints } => write!(
+                f,
+                "{cables} cables for {joints} joints; the closed-form solver needs 3 per joint"
+            ),
+            UnsupportedRouting::JointCables { joint, cables } => write!(
+                f,
+                "joint {} has {cables} cables; the single-joint model needs its own three",
+                joint + 1
+            ),
+            UnsupportedRouting::CableOrder { cable, joint } => write!(
+                f,
+                "cable `{cable}` drives joint {}; expected 3 cables per joint, in joint order",
+                joint + 1
+            ),
+            UnsupportedRouting::BeyondOwnJoint { cable, joint } => write!(
+                f,
+                "cable `{cable}` of joint {} changes length with joints beyond its own",
+                joint + 1
+            ),
+        }
+    }
+}
+
 /// Everything that can go wrong in the statics.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -64,7 +133,7 @@ pub enum StaticsError {
         reason: InfeasibleReason,
     },
     /// A torque with a NaN or infinite component.
-    #[error("joint {}: torque [{}, {}] is not finite", .joint + 1, .torque[0], .torque[1])]
+    #[error("joint {}: torque [{}, {}] is not finite", .joint + 1, Compact(.torque[0]), Compact(.torque[1]))]
     NonFiniteTorque {
         /// Universal joint index (0-based).
         joint: usize,
@@ -72,7 +141,7 @@ pub enum StaticsError {
         torque: [f64; 2],
     },
     /// A tension level outside `[0, 1]` (or NaN).
-    #[error("joint {}: tension level {level} is outside [0, 1]", .joint + 1)]
+    #[error("joint {}: tension level {} is outside [0, 1]", .joint + 1, Compact(*.level))]
     InvalidLevel {
         /// Universal joint index (0-based).
         joint: usize,
@@ -80,11 +149,8 @@ pub enum StaticsError {
         level: f64,
     },
     /// A routing that is not three cables per universal joint (each cable driving one joint).
-    #[error("unsupported routing: {reason}")]
-    UnsupportedRouting {
-        /// What does not fit.
-        reason: String,
-    },
+    #[error("unsupported routing: {0}")]
+    UnsupportedRouting(UnsupportedRouting),
     /// An input of the wrong size.
     #[error("{what}: expected {expected} entries, got {got}")]
     DimensionMismatch {

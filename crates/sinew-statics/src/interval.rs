@@ -48,17 +48,41 @@ pub struct TensionInterval {
     pub lambda_min: f64,
     /// Upper end of the interval (most total tension).
     pub lambda_max: f64,
+    /// The tension limits the interval was clipped to.
+    pub limits: TensionLimits,
+    /// The cable (0, 1 or 2) at `f_min` at `λ_min`, and the one at `f_max` at `λ_max`: at the
+    /// ends they are set exactly on their limit ([`TensionInterval::tensions`]).
+    pub limiting: [usize; 2],
 }
 
 impl TensionInterval {
-    /// Tensions at a point `λ` of the line `P`, N.
+    /// Tensions at a point `λ` of the line `P`, N. Inside the interval every tension is within
+    /// `[f_min, f_max]` exactly (a tension off its limit by rounding only is put on it), and at
+    /// `λ_min` (`λ_max`) the limiting cable is exactly at `f_min` (`f_max`).
     pub fn tensions(&self, lambda: f64) -> Vector3<f64> {
-        self.particular + lambda * self.null
+        let mut f = self.particular + lambda * self.null;
+        let TensionLimits { f_min, f_max } = self.limits;
+        if (self.lambda_min..=self.lambda_max).contains(&lambda) {
+            for v in f.iter_mut() {
+                *v = v.clamp(f_min, f_max);
+            }
+            if lambda == self.lambda_min {
+                f[self.limiting[0].min(2)] = f_min;
+            }
+            if lambda == self.lambda_max {
+                f[self.limiting[1].min(2)] = f_max;
+            }
+        }
+        f
     }
 
-    /// `λ` at tension level `s ∈ [0, 1]` (0: least total tension, 1: most).
+    /// `λ` at tension level `s ∈ [0, 1]` (0: least total tension, 1: most; both ends exactly).
     pub fn lambda_at_level(&self, s: f64) -> f64 {
-        self.lambda_min + s * (self.lambda_max - self.lambda_min)
+        if s == 1.0 {
+            self.lambda_max
+        } else {
+            self.lambda_min + s * (self.lambda_max - self.lambda_min)
+        }
     }
 
     /// Tensions at tension level `s ∈ [0, 1]`, N.
@@ -137,12 +161,19 @@ pub fn tension_interval(
     }
     let mut lambda_min = f64::NEG_INFINITY;
     let mut lambda_max = f64::INFINITY;
+    let mut limiting = [0, 0];
     for k in 0..3 {
-        lambda_min = lambda_min.max((limits.f_min - particular[k]) / null[k]);
-        lambda_max = lambda_max.min((limits.f_max - particular[k]) / null[k]);
+        let lo = (limits.f_min - particular[k]) / null[k];
+        let hi = (limits.f_max - particular[k]) / null[k];
+        if lo > lambda_min {
+            (lambda_min, limiting[0]) = (lo, k);
+        }
+        if hi < lambda_max {
+            (lambda_max, limiting[1]) = (hi, k);
+        }
     }
     if lambda_min > lambda_max {
         return Err(infeasible(InfeasibleReason::OutsideLimits { lambda_min, lambda_max }));
     }
-    Ok(TensionInterval { joint, particular, null, lambda_min, lambda_max })
+    Ok(TensionInterval { joint, particular, null, lambda_min, lambda_max, limits, limiting })
 }

@@ -5,8 +5,9 @@
 //! - cable-joint statics (eq. 5): `τ = −J_cᵀ f` ([`cable_torques`]);
 //! - the feasible tension interval of a 3-cable, 2-DOF joint in closed form (eq. 22–23,
 //!   [`tension_interval`]) and over a whole arm, decoupled or routed ([`distribute_tensions`]);
-//! - joint-end statics (eq. 6–9): `T0 = T_g + J_xᵀ F0` ([`equilibrium_torques`]) and
-//!   `K_W = ∂T0/∂Q` ([`equilibrium_torque_derivative`]);
+//! - joint-end statics (eq. 6–9): `T0 = T_g + J_xᵀ F0` ([`equilibrium_torques`]), and in the
+//!   same pass `J_x` and `K_W = ∂T0/∂Q` as its `O(dof)` generators ([`KwGenerators`], the one
+//!   owner of `∂T0/∂Q`; dense: [`equilibrium_torque_derivative`]);
 //! - all of it for a robot and its routing in one call ([`ArmStatics`]).
 //!
 //! Infeasible loads and lost force closure are typed outcomes ([`StaticsError::Infeasible`]
@@ -21,12 +22,14 @@ mod joint_end;
 
 pub use arm::{ArmStatics, ArmStaticsData};
 pub use distribution::{CableLayout, distribute_tensions};
-pub use error::{InfeasibleReason, StaticsError};
+pub use error::{InfeasibleReason, StaticsError, UnsupportedRouting};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,
     tension_interval,
 };
-pub use joint_end::{JointEndData, equilibrium_torque_derivative, equilibrium_torques};
+pub use joint_end::{
+    JointEndData, KwGenerators, equilibrium_torque_derivative, equilibrium_torques,
+};
 
 use faer::MatRef;
 

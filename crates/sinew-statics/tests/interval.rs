@@ -106,3 +106,27 @@ fn a_nan_torque_is_an_error_not_a_nan() {
     let err = tension_interval(0, &jacobian, &Vector2::new(f64::NAN, 0.0), LIMITS).unwrap_err();
     assert!(matches!(err, StaticsError::NonFiniteTorque { .. }), "{err:?}");
 }
+
+#[test]
+fn tensions_at_a_limit_are_exactly_on_it() {
+    // Within the interval no tension leaves [f_min, f_max] even by rounding, and at the ends
+    // the limiting cable is exactly at its limit (not 19.999999999999996).
+    let mut rng = config::rng(22);
+    let mut checked = 0;
+    for _ in 0..1000 {
+        let jacobian = joint_block(&mut rng);
+        let tau = Vector2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
+        let Ok(interval) = tension_interval(0, &jacobian, &tau, LIMITS) else { continue };
+        checked += 1;
+        let (lo, hi) = interval.ends();
+        assert_eq!(lo.min(), LIMITS.f_min, "{lo:?}");
+        assert_eq!(hi.max(), LIMITS.f_max, "{hi:?}");
+        assert_eq!(interval.tensions_at_level(0.0), lo);
+        assert_eq!(interval.tensions_at_level(1.0), hi);
+        for s in [0.0, 0.3, 0.7, 1.0] {
+            let f = interval.tensions_at_level(s);
+            assert!(f.min() >= LIMITS.f_min && f.max() <= LIMITS.f_max, "{f:?} at level {s}");
+        }
+    }
+    assert!(checked > 100, "only {checked} feasible cases");
+}

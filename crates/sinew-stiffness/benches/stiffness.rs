@@ -13,7 +13,7 @@ use faer::Mat;
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
-use sinew_stiffness::{ArmStiffness, EndSolver, joint_stiffness};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver, joint_stiffness};
 use sinew_testkit::cdhrm5;
 
 fn chain(joints: usize, model: PatternModel) -> (Robot, Routing) {
@@ -59,36 +59,28 @@ fn bench_pipeline(c: &mut Criterion) {
     for model_kind in cdhrm5::MODELS {
         let routing = cdhrm5::routing(&cdhrm5, model_kind);
         let label = format!("{model_kind:?}").to_lowercase();
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&cdhrm5, &routing);
+        let model = ArmStiffness::new(&cdhrm5, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        model.evaluate(&cdhrm5, &routing, &mut data, &pose, &f0, &[0.5; 5]).unwrap();
+        model.evaluate(&mut data, &pose, &f0, &[0.5; 5]).unwrap();
         group.bench_with_input(
             BenchmarkId::new(format!("cdhrm5 loaded {label}"), 10),
             &pose,
-            |b, q| {
-                b.iter(|| {
-                    model
-                        .evaluate(&cdhrm5, &routing, &mut data, black_box(q), &f0, &[0.5; 5])
-                        .unwrap()
-                })
-            },
+            |b, q| b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &[0.5; 5]).unwrap()),
         );
     }
     for joints in [25, 50, 100] {
         for model_kind in [PatternModel::Decoupled, PatternModel::Routed] {
             let (robot, routing) = chain(joints, model_kind);
-            let model = ArmStiffness::new(&routing).unwrap();
-            let mut data = model.data(&robot, &routing);
+            let model = ArmStiffness::new(&robot, &routing).unwrap();
+            let mut data = ArmStiffnessData::new(&model);
             let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
             let levels = vec![0.1; joints];
             let f0 = Vector6::zeros();
-            model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+            model.evaluate(&mut data, &q, &f0, &levels).unwrap();
             let label = format!("uniform {model_kind:?}").to_lowercase();
             group.bench_with_input(BenchmarkId::new(label, 2 * joints), &q, |b, q| {
-                b.iter(|| {
-                    model.evaluate(&robot, &routing, &mut data, black_box(q), &f0, &levels).unwrap()
-                })
+                b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
             });
         }
     }
@@ -97,17 +89,15 @@ fn bench_pipeline(c: &mut Criterion) {
     {
         let (robot, routing) = chain(100, PatternModel::Decoupled);
         let robot = robot.with_gravity(Vector3::new(0.0, 5e-4, 0.0));
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
         let levels = vec![0.1; 100];
         let f0 = Vector6::new(0.0, 0.005, 0.0, 0.0, 0.0, 0.0005);
-        model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        model.evaluate(&mut data, &q, &f0, &levels).unwrap();
         assert_eq!(data.end_solver(), EndSolver::Structured);
         group.bench_with_input(BenchmarkId::new("uniform decoupled loaded", 200), &q, |b, q| {
-            b.iter(|| {
-                model.evaluate(&robot, &routing, &mut data, black_box(q), &f0, &levels).unwrap()
-            })
+            b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
         });
     }
     group.finish();

@@ -14,11 +14,12 @@
 //! unstable equilibrium, or on request ([`stability_margin`]).
 //!
 //! This is the dense path, `O(dof³)`, for any `K_q` and `K_W`: the reference of the structured
-//! `O(dof)` solve that [`crate::ArmStiffness`] uses when `K_q` is block diagonal (see
-//! [`crate::ArmStiffness::evaluate`]). When `K_q + K_W` is exactly symmetric it is solved with
+//! `O(dof)` solve that [`crate::ArmStiffness`] uses when `K_q` is block diagonal (derivation
+//! in `structured/mod.rs`). When `K_q + K_W` is exactly symmetric it is solved with
 //! the Cholesky factor already computed for the verdict, else with a partially pivoted LU.
-//! `K_x = C_x⁻¹` comes from a 6 × 6 LU with partial pivoting on the stack, whose pivots also
-//! decide whether `J_x` has full rank ([`RANK_TOLERANCE`]).
+//! `K_x = C_x⁻¹` comes from a 6 × 6 LU with partial pivoting on the stack (the kernel the
+//! structured solve uses for its pivot blocks), whose pivots also decide whether `J_x` has
+//! full rank ([`RANK_TOLERANCE`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
@@ -125,77 +126,37 @@ impl EndStiffnessData {
             [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
             [0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         ];
-        // Rows of C_x.
-        let mut u = [[0.0; 6]; 6];
+        // Rows of C_x, factorised in place: P C_x = L U (the structured solve's block LU),
+        // the reciprocals of U's pivots on the diagonal.
+        let mut lu = [[0.0; 6]; 6];
         for (j, col) in self.c_x.chunks_exact(6).enumerate() {
             for (i, v) in col.iter().enumerate() {
-                u[i][j] = *v;
+                lu[i][j] = *v;
             }
         }
-        // P C_x = L U by whole-row operations: `u` ends as U (its entries left of the diagonal
-        // are not used), the multipliers go to `l`.
-        let mut l = [[0.0; 6]; 6];
-        let mut perm = [0, 1, 2, 3, 4, 5];
-        let mut inv_pivot = [0.0; 6];
+        let mut perm = [0; 6];
+        let factored = crate::structured::lu(&mut lu, &mut perm);
         let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
-        for c in 0..6 {
-            let mut best = c;
-            for r in c + 1..6 {
-                if u[r][c].abs() > u[best][c].abs() {
-                    best = r;
-                }
+        if factored {
+            for (r, row) in lu.iter().enumerate() {
+                let pivot = 1.0 / row[r];
+                (lo, hi) = (lo.min(pivot.abs()), hi.max(pivot.abs()));
             }
-            if best != c {
-                u.swap(best, c);
-                l.swap(best, c);
-                perm.swap(best, c);
-            }
-            let pivot = u[c][c];
-            (lo, hi) = (lo.min(pivot.abs()), hi.max(pivot.abs()));
-            inv_pivot[c] = 1.0 / pivot;
-            if pivot != 0.0 {
-                let pivot_row = u[c];
-                for r in c + 1..6 {
-                    let f = u[r][c] * inv_pivot[c];
-                    l[r][c] = f;
-                    for (v, p) in u[r].iter_mut().zip(&pivot_row) {
-                        *v -= f * p;
-                    }
-                }
-            }
+        } else {
+            // A zero or non-finite pivot.
+            lo = 0.0;
+            hi = self.c_x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         }
         // Written so that NaN pivots also count as rank-deficient.
-        let full_rank = lo > RANK_TOLERANCE * hi;
+        let full_rank = factored && lo > RANK_TOLERANCE * hi;
         if !full_rank {
             return Err(StiffnessError::RankDeficient {
                 pivot_ratio: if hi > 0.0 { lo / hi } else { 0.0 },
             });
         }
-        // K_x = U⁻¹ L⁻¹ P, all six columns at once (x[r] is row r of the running solution).
-        let mut x = [[0.0; 6]; 6];
-        for r in 0..6 {
-            let mut row = IDENTITY[perm[r]];
-            for k in 0..r {
-                let f = l[r][k];
-                for (v, xk) in row.iter_mut().zip(&x[k]) {
-                    *v -= f * xk;
-                }
-            }
-            x[r] = row;
-        }
-        for r in (0..6).rev() {
-            let mut row = x[r];
-            for k in r + 1..6 {
-                let f = u[r][k];
-                for (v, xk) in row.iter_mut().zip(&x[k]) {
-                    *v -= f * xk;
-                }
-            }
-            for v in row.iter_mut() {
-                *v *= inv_pivot[r];
-            }
-            x[r] = row;
-        }
+        // K_x = U⁻¹ L⁻¹ P, all six columns at once (x[r] is row r of the solution).
+        let mut x = IDENTITY;
+        crate::structured::lu_solve(&lu, &perm, &mut x);
         for (c, col) in self.k_x.chunks_exact_mut(6).enumerate() {
             for (r, out) in col.iter_mut().enumerate() {
                 *out = x[r][c];

@@ -1,13 +1,20 @@
 //! The one error type of this crate.
 
-/// Everything that can go wrong computing a stiffness.
+use sinew_robot::Compact;
+use sinew_statics::StaticsError;
+
+/// Everything that can go wrong computing a stiffness. Each underlying error arrives by one
+/// path: robot and routing errors as [`StiffnessError::Robot`] and [`StiffnessError::Routing`]
+/// (also when the statics met them: the `From<StaticsError>` conversion unwraps them), the
+/// statics' own errors as [`StiffnessError::Statics`].
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum StiffnessError {
     /// `K_q + K_W` is not positive definite: the equilibrium is unstable, and no end stiffness
     /// exists. `min_eigenvalue` is the smallest eigenvalue of its symmetric part (N m/rad).
     #[error(
-        "unstable equilibrium: K_q + K_W is not positive definite (smallest eigenvalue {min_eigenvalue:.6e} N m/rad)"
+        "unstable equilibrium: K_q + K_W is not positive definite (smallest eigenvalue {} N m/rad)",
+        Compact(*.min_eigenvalue)
     )]
     Unstable {
         /// Smallest eigenvalue of the symmetric part of `K_q + K_W`.
@@ -15,7 +22,8 @@ pub enum StiffnessError {
     },
     /// The end-effector Jacobian has rank < 6: `C_x` is singular and `K_x` does not exist.
     #[error(
-        "the end-effector Jacobian has rank < 6 (smallest/largest pivot of C_x = {pivot_ratio:.3e}); K_x does not exist, C_x does"
+        "the end-effector Jacobian has rank < 6 (smallest/largest pivot of C_x = {}); K_x does not exist, C_x does",
+        Compact(*.pivot_ratio)
     )]
     RankDeficient {
         /// Smallest over largest pivot magnitude of `C_x`'s LU factorisation.
@@ -40,13 +48,40 @@ pub enum StiffnessError {
         /// The size passed.
         got: usize,
     },
-    /// An error of the statics (tensions, torques).
+    /// An [`crate::ArmStiffnessData`] made for another arm (Pinocchio's `model.check(data)`).
+    #[error(
+        "the workspace was made for another arm ({workspace_dof} DOF, {workspace_cables} cables, or other blocks of K_q); this arm has {dof} DOF and {cables} cables: make it with ArmStiffnessData::new(&arm)"
+    )]
+    WorkspaceMismatch {
+        /// DOFs of the arm.
+        dof: usize,
+        /// Cables of the arm.
+        cables: usize,
+        /// DOFs of the arm the workspace was made for.
+        workspace_dof: usize,
+        /// Cables of the arm the workspace was made for.
+        workspace_cables: usize,
+    },
+    /// An error of the statics itself (tensions, torques, unsupported routing).
     #[error(transparent)]
-    Statics(#[from] sinew_statics::StaticsError),
+    Statics(StaticsError),
     /// An error of the robot model.
     #[error(transparent)]
     Robot(#[from] sinew_robot::RobotError),
     /// An error of the cable geometry.
     #[error(transparent)]
     Routing(#[from] sinew_routing::RoutingError),
+}
+
+impl From<StaticsError> for StiffnessError {
+    /// The statics' robot and routing errors become [`StiffnessError::Robot`] and
+    /// [`StiffnessError::Routing`] (one path per underlying error); the rest
+    /// [`StiffnessError::Statics`].
+    fn from(e: StaticsError) -> StiffnessError {
+        match e {
+            StaticsError::Robot(e) => StiffnessError::Robot(e),
+            StaticsError::Routing(e) => StiffnessError::Routing(e),
+            e => StiffnessError::Statics(e),
+        }
+    }
 }

@@ -23,8 +23,9 @@ use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
 use sinew_routing::{Routing, RoutingData, SegmentHessians};
 
+use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
-use crate::structured::{BlockLayout, ColMajor, MAX_BLOCK, zero_blocks};
+use crate::structured::{BlockLayout, MAX_BLOCK, zero_blocks};
 
 fn check(what: &'static str, m: &MatMut<'_, f64>, n: usize) -> Result<(), StiffnessError> {
     for got in [m.nrows(), m.ncols()] {

@@ -8,16 +8,20 @@
 //! - end compliance and stiffness `C_x = J_x (K_q + K_W)⁻¹ J_xᵀ`, `K_x = C_x⁻¹`
 //!   ([`end_compliance`], [`end_stiffness`]), with unstable equilibria and rank-deficient
 //!   Jacobians as typed outcomes;
-//! - the whole pipeline `Q → K_x` for a robot and its routing ([`ArmStiffness`]).
+//! - the whole pipeline `Q → K_x` for a robot and its routing: the model [`ArmStiffness`] and
+//!   its workspace [`ArmStiffnessData`].
 #![deny(missing_docs)]
 
 mod arm;
+mod colmajor;
+mod data;
 mod end;
 mod error;
 mod joint;
 mod structured;
 
-pub use arm::{ArmStiffness, ArmStiffnessData, EndSolver};
+pub use arm::{ArmStiffness, EndSolver};
+pub use data::ArmStiffnessData;
 pub use end::{EndStiffnessData, RANK_TOLERANCE, end_compliance, end_stiffness, stability_margin};
 pub use error::StiffnessError;
 pub use joint::{joint_block, joint_stiffness, stiffness_slope};

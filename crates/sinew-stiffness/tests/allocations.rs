@@ -9,7 +9,7 @@
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::Robot;
 use sinew_routing::{PatternModel, Routing};
-use sinew_stiffness::{ArmStiffness, EndSolver};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver};
 use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 use sinew_testkit::{cdhrm5, config};
 
@@ -39,8 +39,8 @@ fn evaluating_the_pipeline_allocates_nothing() {
     assert_counting();
     for (name, robot, routing, solver) in arms() {
         let n = robot.dof();
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let mut rng = config::rng(17);
         // Around a loaded pose (E4 rounded) for cdhrm5, around the straight arm (slightly bent)
         // for the chain.
@@ -54,15 +54,15 @@ fn evaluating_the_pipeline_allocates_nothing() {
             Vector6::new(0.0, f, 0.0, 0.0, 0.0, 0.0),
         ];
         // Warm-up: the first evaluation and the first request of K_W.
-        model.evaluate(&robot, &routing, &mut data, &qs[0], &loads[0], &levels).unwrap();
+        model.evaluate(&mut data, &qs[0], &loads[0], &levels).unwrap();
         let _ = data.k_w();
 
         let (allocations, ()) = count(|| {
             for q in &qs {
                 for f0 in &loads {
-                    model.evaluate(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                    model.evaluate(&mut data, q, f0, &levels).unwrap();
                     assert_eq!(data.end_solver(), solver, "{name}");
-                    model.evaluate_compliance(&robot, &routing, &mut data, q, f0, &levels).unwrap();
+                    model.evaluate_compliance(&mut data, q, f0, &levels).unwrap();
                     // K_W is filled on request, into the storage kept from the last request.
                     assert!(data.k_w()[(0, 0)].is_finite());
                 }

@@ -7,7 +7,7 @@ use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
-use sinew_stiffness::ArmStiffness;
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::numeric::{H, central_difference, max_abs};
 use sinew_testkit::{cdhrm5, config};
 
@@ -27,8 +27,8 @@ fn cable_torque(robot: &Robot, routing: &Routing, q: &[f64], f0: &[f64], l0: &[f
 fn k_is_minus_the_derivative_of_the_cable_torque() {
     for (name, robot, routing) in cdhrm5::cases(10) {
         let robot = robot.with_gravity(Vector3::zeros());
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let n = robot.dof();
         let joints = n / 2;
         let mut rng = config::rng(61);
@@ -37,10 +37,7 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
         while checked < 20 {
             let q: Vec<f64> = config::random_q(&robot, &mut rng);
             let levels: Vec<f64> = (0..joints).map(|_| rng.random_range(0.0..0.3)).collect();
-            if model
-                .joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &levels)
-                .is_err()
-            {
+            if model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).is_err() {
                 continue;
             }
             checked += 1;
@@ -65,13 +62,11 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
 fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
     for (name, robot, routing) in cdhrm5::cases(10) {
         let robot = robot.with_gravity(Vector3::zeros());
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let n = robot.dof();
         let q: Vec<f64> = (0..n).map(|i| 0.1 * ((i as f64) * 1.7).sin()).collect();
-        model
-            .joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2])
-            .unwrap();
+        model.joint_level(&mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2]).unwrap();
         let k = data.k_q();
         let mut off_block: f64 = 0.0;
         for j in 0..n {
@@ -97,19 +92,19 @@ fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
 fn the_stiffness_slope_predicts_a_change_of_tension_level() {
     // Decoupled: moving joint i's level moves only its λ; K_q is affine in it.
     let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
     let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];
     let f0 = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
     for joint in 0..5 {
         let mut levels = [0.2; 5];
-        model.joint_level(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        model.joint_level(&mut data, &q, &f0, &levels).unwrap();
         let k_before = data.k_q().to_owned();
         let lambda_before = data.intervals()[joint].lambda_at_level(0.2);
         let mut slope = Mat::zeros(10, 10);
-        model.stiffness_slope(&routing, &mut data, joint, slope.as_mut()).unwrap();
+        model.stiffness_slope(&mut data, joint, slope.as_mut()).unwrap();
         levels[joint] = 0.9;
-        model.joint_level(&robot, &routing, &mut data, &q, &f0, &levels).unwrap();
+        model.joint_level(&mut data, &q, &f0, &levels).unwrap();
         let delta = data.intervals()[joint].lambda_at_level(0.9) - lambda_before;
         let predicted = &k_before + &slope * faer::Scale(delta);
         let err = max_abs((data.k_q().to_owned() - &predicted).as_ref()) / max_abs(data.k_q());
@@ -121,10 +116,10 @@ fn the_stiffness_slope_predicts_a_change_of_tension_level() {
 #[test]
 fn routed_tension_sensitivity_keeps_every_joint_balanced() {
     let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
     let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.3, 0.05, 0.15];
-    model.joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &[0.1; 5]).unwrap();
+    model.joint_level(&mut data, &q, &Vector6::zeros(), &[0.1; 5]).unwrap();
     let mut delta = vec![0.0; 15];
     for joint in 0..5 {
         model

@@ -1,6 +1,6 @@
 //! The structured `O(dof)` end solve of the decoupled model against the dense reference
-//! (faer's Cholesky/LU of `K_q + K_W`, with `K_W` from sinew-statics'
-//! `equilibrium_torque_derivative`): `C_x`, `K_x`, the stability verdict and the reported
+//! (faer's Cholesky/LU of `K_q + K_W`, with `K_W` from sinew-robot's dense
+//! `gravity_torque_derivative` + `wrench_torque_derivative`, independent of the generators): `C_x`, `K_x`, the stability verdict and the reported
 //! smallest eigenvalue, on cdhrm5 and generated chains of 5, 25 and 100 universal joints,
 //! gravity on and off, `F0` zero, a force, a force and a moment; unstable and rank-deficient
 //! equilibria; and which solver ran.
@@ -60,8 +60,19 @@ fn setups() -> Vec<Setup> {
     v
 }
 
+/// `K_W` from sinew-robot's dense derivatives (`∂T_g/∂Q + ∂(J_xᵀF0)/∂Q`), independent of the
+/// generators sinew-statics builds it from.
+fn dense_k_w(robot: &Robot, rdata: &mut RobotData, f0: &Vector6<f64>) -> Mat<f64> {
+    let n = robot.dof();
+    let mut k_w = Mat::zeros(n, n);
+    robot.gravity_torque_derivative(rdata, k_w.as_mut()).unwrap();
+    let mut load = Mat::zeros(n, n);
+    robot.wrench_torque_derivative(rdata, &robot.tip_point(), f0, load.as_mut()).unwrap();
+    k_w + load
+}
+
 /// The dense reference at the configuration last evaluated in `data`: `K_W` from
-/// `equilibrium_torque_derivative` (independent of the generators), then `end_stiffness`.
+/// [`dense_k_w`] (independent of the generators), then `end_stiffness`.
 fn reference(
     robot: &Robot,
     q: &[f64],
@@ -71,15 +82,7 @@ fn reference(
     let n = robot.dof();
     let mut rdata = RobotData::new(robot);
     robot.forward_kinematics(&mut rdata, q).unwrap();
-    let mut k_w = Mat::zeros(n, n);
-    equilibrium_torque_derivative(
-        robot,
-        &mut rdata,
-        &mut JointEndData::new(robot),
-        f0,
-        k_w.as_mut(),
-    )
-    .unwrap();
+    let k_w = dense_k_w(robot, &mut rdata, f0);
     let mut end = EndStiffnessData::new(n);
     let outcome = end_stiffness(data.k_q(), k_w.as_ref(), data.j_x(), &mut end);
     (k_w, end, outcome)
@@ -91,7 +94,7 @@ fn compare(
     robot: &Robot,
     q: &[f64],
     f0: &Vector6<f64>,
-    data: &ArmStiffnessData,
+    data: &mut ArmStiffnessData,
     outcome: &Result<(), StiffnessError>,
 ) -> &'static str {
     compare_with_errors(label, robot, q, f0, data, outcome).0
@@ -103,7 +106,7 @@ fn compare_with_errors(
     robot: &Robot,
     q: &[f64],
     f0: &Vector6<f64>,
-    data: &ArmStiffnessData,
+    data: &mut ArmStiffnessData,
     outcome: &Result<(), StiffnessError>,
 ) -> (&'static str, f64, f64) {
     let (k_w, end, expected) = reference(robot, q, f0, data);
@@ -167,7 +170,6 @@ fn random_load(rng: &mut impl Rng, kind: Load, force: f64) -> Vector6<f64> {
 fn the_structured_solve_matches_the_dense_reference() {
     for (index, setup) in setups().into_iter().enumerate() {
         let Setup { name, robot: base, routing, gravity, force, reach } = setup;
-        let model = ArmStiffness::new(&routing).unwrap();
         let joints = base.dof() / 2;
         for gravity_on in [true, false] {
             let g = if gravity_on {
@@ -176,7 +178,8 @@ fn the_structured_solve_matches_the_dense_reference() {
                 Vector3::zeros()
             };
             let robot = base.with_gravity(g);
-            let mut data = model.data(&robot, &routing);
+            let model = ArmStiffness::new(&robot, &routing).unwrap();
+            let mut data = ArmStiffnessData::new(&model);
             for kind in [Load::Zero, Load::Force, Load::ForceAndMoment] {
                 let mut rng = config::rng(71 + index as u64);
                 let (mut checked, mut infeasible, mut stable) = (0, 0, 0);
@@ -199,14 +202,14 @@ fn the_structured_solve_matches_the_dense_reference() {
                     let levels: Vec<f64> =
                         (0..joints).map(|_| rng.random_range(0.0..=1.0)).collect();
                     let f0 = random_load(&mut rng, kind, force);
-                    let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels);
+                    let outcome = model.evaluate(&mut data, &q, &f0, &levels);
                     if let Err(StiffnessError::Statics(_)) = outcome {
                         infeasible += 1;
                         continue;
                     }
                     let label = format!("{name} g={gravity_on} {kind:?} #{checked}");
                     let (verdict, c_err, k_err) =
-                        compare_with_errors(&label, &robot, &q, &f0, &data, &outcome);
+                        compare_with_errors(&label, &robot, &q, &f0, &mut data, &outcome);
                     if verdict == "stable" {
                         stable += 1;
                     }
@@ -240,8 +243,8 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
         },
     ] {
         let robot = robot.with_gravity(Vector3::zeros());
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let mut rng = config::rng(5);
         for step in 0..60 {
             let q: Vec<f64> = (0..robot.dof()).map(|_| rng.random_range(-0.05..0.05)).collect();
@@ -251,11 +254,12 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
                 Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.0),
                 Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.05 * push),
             ] {
-                let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.0; 5]);
+                let outcome = model.evaluate(&mut data, &q, &f0, &[0.0; 5]);
                 if let Err(StiffnessError::Statics(_)) = outcome {
                     continue;
                 }
-                match compare(&format!("{name} push {push}"), &robot, &q, &f0, &data, &outcome) {
+                match compare(&format!("{name} push {push}"), &robot, &q, &f0, &mut data, &outcome)
+                {
                     "unstable" => unstable += 1,
                     "stable" => stable += 1,
                     _ => {}
@@ -281,17 +285,17 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
             ("uniform25", robot.with_gravity(Vector3::zeros()), routing)
         },
     ] {
-        let model = ArmStiffness::new(&routing).unwrap();
-        let mut data = model.data(&robot, &routing);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let q = vec![0.0; robot.dof()];
         let levels = vec![0.3; robot.dof() / 2];
         for f0 in [Vector6::zeros(), Vector6::new(0.0, 0.0, -1.0, 0.0, 0.0, 0.0)] {
-            let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &levels);
+            let outcome = model.evaluate(&mut data, &q, &f0, &levels);
             assert!(
                 matches!(outcome, Err(StiffnessError::RankDeficient { .. })),
                 "{name}: {outcome:?}"
             );
-            assert_eq!(compare(name, &robot, &q, &f0, &data, &outcome), "rank-deficient");
+            assert_eq!(compare(name, &robot, &q, &f0, &mut data, &outcome), "rank-deficient");
             // No rotation about z: the last row and column of C_x vanish (to rounding).
             let c = data.compliance();
             assert!(c[(5, 5)].abs() <= 1e-12 * max_abs(c), "{name}: C_x[5,5] = {:e}", c[(5, 5)]);
@@ -302,13 +306,13 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
 #[test]
 fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
     assert_eq!(data.end_solver(), EndSolver::NotYet);
     // A loaded pose (E4 rounded: the pose itself does not matter here, only the path).
     let q = cdhrm5::LOADED_POSE;
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    let outcome = model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]);
+    let outcome = model.evaluate(&mut data, &q, &f0, &[0.5; 5]);
     // K_q is full (a cable crosses every proximal joint): the dense path. It is exactly
     // symmetric (each product of J_cᵀ K_l J_c computed once), so with a pure force the dense
     // path solves with the Cholesky factor of its verdict.
@@ -319,9 +323,9 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     assert!(rel_diff(data.compliance(), end.compliance()) <= RTOL);
     // The decoupled routing of the same robot takes the structured path.
     let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
-    model.evaluate(&robot, &routing, &mut data, &q, &f0, &[0.5; 5]).unwrap();
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
+    model.evaluate(&mut data, &q, &f0, &[0.5; 5]).unwrap();
     assert_eq!(data.end_solver(), EndSolver::Structured);
 }
 
@@ -332,14 +336,14 @@ fn k_q_outside_the_joint_blocks_stays_exactly_zero() {
     // `joint_stiffness` sum.
     let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
     let robot = robot.with_gravity(Vector3::new(0.0, 0.3, 0.0));
-    let model = ArmStiffness::new(&routing).unwrap();
-    let mut data = model.data(&robot, &routing);
+    let model = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&model);
     let n = robot.dof();
     let mut rng = config::rng(9);
     for _ in 0..10 {
         let q: Vec<f64> = (0..n).map(|_| rng.random_range(-0.1..0.1)).collect();
         let levels: Vec<f64> = (0..n / 2).map(|_| rng.random_range(0.0..1.0)).collect();
-        model.joint_level(&robot, &routing, &mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).unwrap();
         let mut kc = Mat::<f64>::zeros(n, n);
         let mut ki = Mat::<f64>::zeros(n, n);
         sinew_stiffness::joint_stiffness(
@@ -364,8 +368,8 @@ fn the_generators_rebuild_k_w_and_j_x() {
     for setup in setups() {
         let robot = &setup.robot;
         let n = robot.dof();
-        let model = ArmStiffness::new(&setup.routing).unwrap();
-        let mut data = model.data(robot, &setup.routing);
+        let model = ArmStiffness::new(robot, &setup.routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
         let mut rdata = RobotData::new(robot);
         let tip = robot.tip_point();
         for _ in 0..20 {
@@ -409,7 +413,7 @@ fn the_generators_rebuild_k_w_and_j_x() {
             }
             // The pipeline: J_x exactly, K_W to rounding.
             let levels = vec![0.5; n / 2];
-            if model.joint_level(robot, &setup.routing, &mut data, &q, &f0, &levels).is_ok() {
+            if model.joint_level(&mut data, &q, &f0, &levels).is_ok() {
                 assert_eq!(data.j_x().to_owned(), j_x, "{}: J_x", setup.name);
                 let mut k_w = Mat::zeros(n, n);
                 equilibrium_torque_derivative(
@@ -425,4 +429,26 @@ fn the_generators_rebuild_k_w_and_j_x() {
             }
         }
     }
+}
+
+#[test]
+fn a_workspace_made_for_another_arm_is_a_typed_mismatch() {
+    let robot = cdhrm5::robot();
+    let load = |model| cdhrm5::routing(&robot, model);
+    let decoupled = ArmStiffness::new(&robot, &load(PatternModel::Decoupled)).unwrap();
+    let routed = ArmStiffness::new(&robot, &load(PatternModel::Routed)).unwrap();
+    let (chain_robot, chain_routing) = cdhrm5::chain(10, PatternModel::Decoupled);
+    let longer = ArmStiffness::new(&chain_robot, &chain_routing).unwrap();
+    let mut data = ArmStiffnessData::new(&decoupled);
+    let (q, f0, levels) = ([0.1; 10], Vector6::zeros(), [0.5; 5]);
+    decoupled.joint_level(&mut data, &q, &f0, &levels).unwrap();
+    assert!(decoupled.check(&data).is_ok());
+    for arm in [&routed, &longer] {
+        assert!(matches!(arm.check(&data), Err(StiffnessError::WorkspaceMismatch { .. })));
+        let err = arm.evaluate(&mut data, &q, &f0, &levels).unwrap_err();
+        assert!(matches!(err, StiffnessError::WorkspaceMismatch { .. }), "{err:?}");
+    }
+    // A routing built for another robot is refused when the model is made.
+    let err = ArmStiffness::new(&chain_robot, &load(PatternModel::Decoupled)).unwrap_err();
+    assert!(matches!(err, StiffnessError::Routing(_)), "{err:?}");
 }

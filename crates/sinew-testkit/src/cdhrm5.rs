@@ -53,12 +53,9 @@ pub fn dir() -> PathBuf {
     workspace_root().join("robots").join("cdhrm5")
 }
 
-/// The routing file of a cable model: `cables.toml` (decoupled) or `cables-routed.toml`.
+/// The routing file of a cable model ([`sinew_routing::routing_file`]).
 pub fn routing_file(model: PatternModel) -> &'static str {
-    match model {
-        PatternModel::Decoupled => "cables.toml",
-        PatternModel::Routed => "cables-routed.toml",
-    }
+    sinew_routing::routing_file(model)
 }
 
 /// The platform, loaded from the repository's robot files.

@@ -1,0 +1,198 @@
+//! The per-configuration computation: lengths, `J_c` and the segment Hessians (module docs
+//! of [`super`]).
+
+use super::{Order, RoutingData};
+use crate::error::{Result, RoutingError};
+use crate::routing::{MIN_SEGMENT_LENGTH, Routing};
+use sinew_robot::{Robot, RobotData};
+
+/// Forward kinematics at `q`, then [`compute_cable_geometry_from_kinematics`]: the cable
+/// lengths, and up to `order` the cable Jacobian and the cables' Hessians, into `data`.
+///
+/// # Math
+/// See [`compute_cable_geometry_from_kinematics`]: eq. 2–3; shapes `L` m, `J_c` m × dof,
+/// `H_c` dof × dof.
+///
+/// # Errors
+/// [`RoutingError::RobotMismatch`], [`RoutingError::WorkspaceMismatch`],
+/// [`RoutingError::Robot`] for a wrong or non-finite `q`, [`RoutingError::DegenerateSegment`].
+pub fn compute_cable_geometry(
+    routing: &Routing,
+    robot: &Robot,
+    robot_data: &mut RobotData,
+    data: &mut RoutingData,
+    q: &[f64],
+    order: Order,
+) -> Result<()> {
+    routing.check_robot(robot)?;
+    data.computed = None;
+    robot.forward_kinematics(robot_data, q)?;
+    compute_cable_geometry_from_kinematics(routing, robot, robot_data, data, order)
+}
+
+/// The cable lengths, and up to `order` the cable Jacobian and the cables' Hessians, from
+/// forward kinematics already computed in `robot_data` (by `robot.forward_kinematics`; this
+/// function cannot tell which `Q` that was).
+///
+/// Allocates nothing. On error `data` holds nothing valid ([`RoutingData::computed`] is `None`).
+///
+/// # Math
+/// Frames: `o_` is the base frame. Joint `j` has the unit axis `a_j` through the point `p_j`.
+/// A segment joins a hole `o_p_A` on body `A` to a hole `o_p_B` on body `B > A`:
+/// `d = o_p_B − o_p_A`, `L = |d|`, `u = d / L`. Joints before `A` move both holes rigidly and
+/// joints from `B` on move neither, so `L` depends only on `q_A … q_{B−1}`. For `i, k` in that
+/// range, with `v_i = a_i × (o_p_B − p_i) = ∂d/∂q_i` and `∂²d/∂q_i∂q_k = a_min × v_max`:
+///
+/// ```text
+/// ∂L/∂q_i       = u · v_i                                                   (eq. 3)
+/// ∂²L/∂q_i∂q_k  = ( v_i · v_k − (u · v_i)(u · v_k) + d · (a_min × v_max) ) / L
+/// ```
+///
+/// A cable's length is the sum of its segments' (eq. 2 for one joint); its row of `J_c`
+/// (m × dof) and its Hessian (dof × dof) are the sums of theirs, with exact zeros outside each
+/// segment's joints. Cost `O(dof + Σ_s |dofs_s|²)`.
+///
+/// # Errors
+/// [`RoutingError::RobotMismatch`], [`RoutingError::WorkspaceMismatch`],
+/// [`RoutingError::DegenerateSegment`] when a segment is shorter than
+/// [`MIN_SEGMENT_LENGTH`] (never a NaN).
+pub fn compute_cable_geometry_from_kinematics(
+    routing: &Routing,
+    robot: &Robot,
+    robot_data: &RobotData,
+    data: &mut RoutingData,
+    order: Order,
+) -> Result<()> {
+    routing.check_robot(robot)?;
+    data.check(routing)?;
+    data.computed = None;
+    let dof = routing.dof;
+    if robot_data.joint_axis(dof.saturating_sub(1)).is_none()
+        || robot_data.joint_axis(dof).is_some()
+        || robot_data.body_pose(dof).is_none()
+    {
+        let got = (0..).take_while(|&j| robot_data.joint_axis(j).is_some()).count();
+        return Err(RoutingError::WorkspaceMismatch {
+            what: "robot workspace (joints)",
+            expected: dof,
+            got,
+        });
+    }
+    // The kinematics as plain arrays (base frame), once per evaluation.
+    for b in 0..=dof {
+        let (Some(pose), Some(frame)) = (robot_data.body_pose(b), data.frames.get_mut(b)) else {
+            return Err(mismatch(dof));
+        };
+        // Column-major rotation, then the translation.
+        frame[..9].copy_from_slice(pose.rotation.matrix().as_slice());
+        frame[9..].copy_from_slice(pose.translation.vector.as_slice());
+    }
+    for j in 0..dof {
+        let (Some(a), Some(p)) = (robot_data.joint_axis(j), robot_data.joint_origin(j)) else {
+            return Err(mismatch(dof));
+        };
+        data.axes[j] = [a[0], a[1], a[2]];
+        data.origins[j] = [p[0], p[1], p[2]];
+    }
+
+    data.lengths.fill(0.0);
+    if order >= Order::Jacobian {
+        data.jacobian.fill(0.0);
+    }
+    let m = data.cables;
+    let RoutingData {
+        frames,
+        axes,
+        origins,
+        lengths,
+        segment_lengths,
+        jacobian,
+        hessians,
+        v,
+        g,
+        ..
+    } = data;
+    for (s, seg) in routing.segments.iter().enumerate() {
+        let o_p_a = transform(&frames[seg.proximal.body], &seg.proximal_point);
+        let o_p_b = transform(&frames[seg.distal.body], &seg.distal_point);
+        let d = sub(&o_p_b, &o_p_a);
+        let length = dot(&d, &d).sqrt();
+        if length.is_nan() || length < MIN_SEGMENT_LENGTH {
+            let cable = routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default();
+            return Err(RoutingError::DegenerateSegment {
+                cable,
+                segment: seg.index,
+                length,
+                min: MIN_SEGMENT_LENGTH,
+            });
+        }
+        segment_lengths[s] = length;
+        lengths[seg.cable] += length;
+        if order == Order::Lengths || seg.dofs.is_empty() {
+            continue;
+        }
+        let inv_length = 1.0 / length;
+        let u = scale(&d, inv_length);
+        let (lo, n) = (seg.dofs.start, seg.dofs.len());
+        for k in 0..n {
+            // v_k = a_k × (o_p_B − p_k) = ∂d/∂q_k,  g_k = u · v_k = ∂L/∂q_k.
+            let v_k = cross(&axes[lo + k], &sub(&o_p_b, &origins[lo + k]));
+            let g_k = dot(&u, &v_k);
+            v[k] = v_k;
+            g[k] = g_k;
+            jacobian[seg.cable + (lo + k) * m] += g_k;
+        }
+        if order < Order::Hessians {
+            continue;
+        }
+        let block = &mut hessians[seg.hessian_offset..seg.hessian_offset + n * n];
+        for k in 0..n {
+            // d · (a_i × v_k) = a_i · (v_k × d) for i ≤ k.
+            let t = cross(&v[k], &d);
+            let (v_k, g_k) = (v[k], g[k]);
+            for i in 0..=k {
+                let h = (dot(&v[i], &v_k) - g[i] * g_k + dot(&axes[lo + i], &t)) * inv_length;
+                block[i + k * n] = h;
+                block[k + i * n] = h;
+            }
+        }
+    }
+    data.computed = Some(order);
+    Ok(())
+}
+
+fn mismatch(dof: usize) -> RoutingError {
+    RoutingError::WorkspaceMismatch { what: "robot workspace (joints)", expected: dof, got: 0 }
+}
+
+// Plain 3-vector arithmetic: the inner loops stay fast without relying on inlining of generic
+// code (the test profile is opt-level 1).
+
+#[inline(always)]
+fn transform(frame: &[f64; 12], p: &[f64; 3]) -> [f64; 3] {
+    [
+        frame[0] * p[0] + frame[3] * p[1] + frame[6] * p[2] + frame[9],
+        frame[1] * p[0] + frame[4] * p[1] + frame[7] * p[2] + frame[10],
+        frame[2] * p[0] + frame[5] * p[1] + frame[8] * p[2] + frame[11],
+    ]
+}
+
+#[inline(always)]
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn scale(a: &[f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+#[inline(always)]
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}

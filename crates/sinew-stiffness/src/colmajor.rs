@@ -1,0 +1,55 @@
+//! `ColMajor`: the dense dof × dof and 6 × dof matrices of the pipeline, in plain `Vec`s.
+
+use faer::{MatMut, MatRef};
+
+/// A dense column-major matrix in a plain `Vec` (no padding), viewed as a faer matrix at the
+/// API boundary; the structured kernels read it by slices.
+#[derive(Clone)]
+pub(crate) struct ColMajor {
+    rows: usize,
+    cols: usize,
+    data: Vec<f64>,
+}
+
+impl ColMajor {
+    pub(crate) fn zeros(rows: usize, cols: usize) -> ColMajor {
+        ColMajor { rows, cols, data: vec![0.0; rows * cols] }
+    }
+
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+
+    pub(crate) fn cols(&self) -> usize {
+        self.cols
+    }
+
+    pub(crate) fn as_ref(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.data, self.rows, self.cols)
+    }
+
+    pub(crate) fn as_mut(&mut self) -> MatMut<'_, f64> {
+        MatMut::from_column_major_slice_mut(&mut self.data, self.rows, self.cols)
+    }
+
+    #[inline(always)]
+    pub(crate) fn at(&self, i: usize, j: usize) -> f64 {
+        self.data[i + j * self.rows]
+    }
+
+    #[inline(always)]
+    pub(crate) fn at_mut(&mut self, i: usize, j: usize) -> &mut f64 {
+        &mut self.data[i + j * self.rows]
+    }
+
+    #[inline(always)]
+    pub(crate) fn col_mut(&mut self, j: usize) -> &mut [f64] {
+        &mut self.data[j * self.rows..(j + 1) * self.rows]
+    }
+}
+
+impl std::fmt::Debug for ColMajor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.as_ref().fmt(f)
+    }
+}
