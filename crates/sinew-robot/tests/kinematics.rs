@@ -125,3 +125,33 @@ fn gravity_comes_from_the_description() {
     // About y, gravity (along y) has no moment.
     assert_relative_eq!(tg[1], 0.0, epsilon = 1e-12);
 }
+
+#[test]
+fn random_geometry_link_poses_match_an_independent_product_of_urdf_transforms() {
+    // Random rpy, offsets and unit axes (sinew_testkit::random_chain): every link frame as
+    // the robot places it (body pose · body_M_link) against the URDF's numbers composed
+    // independently, `pose(child) = pose(parent) · origin · Rot(axis, q)`.
+    let mut worst: f64 = 0.0;
+    for (joints, seed) in [(5, 1), (12, 2)] {
+        let chain = sinew_testkit::random_chain::RandomChain::new(joints, seed);
+        let robot = chain.robot();
+        assert_eq!(robot.dof(), 2 * joints);
+        let mut data = RobotData::new(&robot);
+        let mut rng = config::rng(seed);
+        for _ in 0..20 {
+            let q = config::random_q(&robot, &mut rng);
+            robot.forward_kinematics(&mut data, &q).unwrap();
+            let expected = chain.link_poses(&q);
+            assert_eq!(expected.len(), robot.links().len(), "{}: link count", chain.name);
+            for link in robot.links() {
+                let got = data.body_pose(link.body).unwrap() * link.body_m_link;
+                let want = expected[&link.name].to_matrix();
+                let err = (got.to_homogeneous() - want).abs().max();
+                worst = worst.max(err);
+                assert!(err <= 2e-14, "{} {}: pose off by {err:e} at {q:?}", chain.name, link.name);
+            }
+        }
+    }
+    // Measured worst 3.83e-15 (bound 2e-14).
+    println!("random chains: worst link pose error {worst:.2e}");
+}

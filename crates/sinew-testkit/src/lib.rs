@@ -8,6 +8,8 @@
 //! - [`cdhrm5`]: the platform's files loaded from the workspace root, the uniform chain with
 //!   its link and cable pattern, and the calibrated pattern constants;
 //! - [`config`]: seeded random configurations within the joint limits;
+//! - [`random_chain`]: seeded random-geometry chains (random rpy, axes, offsets, inertials)
+//!   with their link poses computed independently and pattern or explicit routings;
 //! - [`numeric`]: the relative-error measures and the central-difference helpers that check
 //!   every analytic derivative.
 //!
@@ -24,3 +26,4 @@ pub mod alloc;
 pub mod cdhrm5;
 pub mod config;
 pub mod numeric;
+pub mod random_chain;
