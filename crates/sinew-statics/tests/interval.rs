@@ -26,7 +26,7 @@ fn every_level_balances_the_torque_and_the_ends_are_exact() {
     let mut rng = config::rng(21);
     let mut checked = 0;
     let (mut worst_residual, mut worst_limit, mut narrowest) = (0.0_f64, 0.0_f64, f64::INFINITY);
-    let outside = |f: Vector3<f64>| f.iter().any(|&x| x < LIMITS.f_min || x > LIMITS.f_max);
+    let outside = |f: Vector3<f64>| f.iter().any(|x| !(LIMITS.f_min..=LIMITS.f_max).contains(x));
     for _ in 0..1000 {
         let jacobian = joint_block(&mut rng);
         let tau = Vector2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
