@@ -39,6 +39,54 @@ fn table_1() {
     assert_eq!(&paper::table_1(&root().join(paper::ROBOT_DIR)).unwrap(), table);
 }
 
+/// Table I's values (paper §V) from the loaded robot, routing and URDF, not from the rendered
+/// text: the snapshot above only echoes the robot files.
+#[test]
+fn table_1_values_are_the_papers() {
+    let r = report();
+    let dir = root().join(paper::ROBOT_DIR);
+    let description = sinew::robot::RobotDescription::read(&dir).unwrap();
+    // Single link size φ60 × 220 mm: five cylinder links, each that size.
+    let urdf = urdf_rs::read_file(&description.urdf).unwrap();
+    let cylinders: Vec<(f64, f64)> = urdf
+        .links
+        .iter()
+        .flat_map(|link| &link.visual)
+        .filter_map(|v| match v.geometry {
+            urdf_rs::Geometry::Cylinder { radius, length } => Some((radius, length)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(cylinders.len(), 5, "{cylinders:?}");
+    for (radius, length) in cylinders {
+        assert!((2.0 * radius - 0.060).abs() <= 1e-12 && (length - 0.220).abs() <= 1e-12);
+    }
+    // Total mass 1.2 kg; load capability 0.8 kg.
+    assert!((r.robot.moving_mass() - 1.2).abs() <= 1e-12, "{} kg", r.robot.moving_mass());
+    assert_eq!(description.payload, Some(0.8));
+    // 5 universal joints, 10 DOF: pairs of orthogonal axes.
+    assert_eq!(r.robot.dof(), 10);
+    assert_eq!(r.robot.joints().len(), 10);
+    for pair in r.robot.joints().chunks(2) {
+        assert!(
+            pair[0].axis.dot(&pair[1].axis).abs() <= 1e-12,
+            "{} {}",
+            pair[0].name,
+            pair[1].name
+        );
+    }
+    // Every joint limited to [−π/6, π/6].
+    for joint in r.robot.joints() {
+        let sixth = std::f64::consts::FRAC_PI_6;
+        assert!((joint.lower + sixth).abs() <= 1e-12, "{}: {}", joint.name, joint.lower);
+        assert!((joint.upper - sixth).abs() <= 1e-12, "{}: {}", joint.name, joint.upper);
+    }
+    // Cables: E = 12.5 GPa, f ∈ [20, 600] N; three per joint.
+    assert_eq!(r.routing.youngs_modulus(), 12.5e9);
+    assert_eq!(r.routing.tension_limits(), [20.0, 600.0]);
+    assert_eq!(r.routing.cable_count(), 15);
+}
+
 #[test]
 fn table_2() {
     let rendered = paper::render_table_2(&report().table_2);
@@ -51,6 +99,66 @@ fn fig_4_e2() {
     let csv = paper::e2_csv(&report().e2);
     insta::assert_snapshot!(csv);
     assert_committed("fig4_e2.csv", &csv);
+}
+
+/// Joint 1's stiffness block `K_q[0..2, 0..2]` at `E2_Q` recomputed from the three tensions
+/// alone (spec §3: `Σ f_c H_c + J_cᵀ K_l J_c`), and the torque those tensions hold.
+fn e2_direct(tensions: [f64; 3]) -> (nalgebra::Matrix2<f64>, nalgebra::Vector2<f64>) {
+    use sinew::routing::{Order, RoutingData, compute_cable_geometry};
+    let r = report();
+    let n = r.robot.dof();
+    let mut q = vec![0.0; n];
+    q[2 * paper::SINGLE_JOINT..2 * paper::SINGLE_JOINT + 2].copy_from_slice(&paper::E2_Q);
+    let mut rdata = sinew::robot::RobotData::new(&r.robot);
+    let mut g = RoutingData::new(&r.routing);
+    compute_cable_geometry(&r.routing, &r.robot, &mut rdata, &mut g, &q, Order::Hessians).unwrap();
+    let mut f = vec![0.0; r.routing.cable_count()];
+    f[3 * paper::SINGLE_JOINT..3 * paper::SINGLE_JOINT + 3].copy_from_slice(&tensions);
+    let (mut kc, mut ki) = (faer::Mat::zeros(n, n), faer::Mat::zeros(n, n));
+    sinew::stiffness::joint_stiffness(&r.routing, &g, &f, kc.as_mut(), ki.as_mut()).unwrap();
+    let k = &kc + &ki;
+    let d = 2 * paper::SINGLE_JOINT;
+    let j = g.jacobian().unwrap();
+    let tau = nalgebra::Vector2::from_fn(|col, _| {
+        -(0..3).map(|c| j[(3 * paper::SINGLE_JOINT + c, d + col)] * tensions[c]).sum::<f64>()
+    });
+    (nalgebra::Matrix2::from_fn(|a, b| k[(d + a, d + b)]), tau)
+}
+
+/// E2's "the other two tensions rise linearly" is true by construction (`f = f_p + λ n`);
+/// the stiffness half is not: `K` recomputed from the tensions at every sampled level must
+/// equal the report's value and lie on the line through the two direct end evaluations.
+#[test]
+fn e2_stiffness_is_affine_in_the_level_by_direct_evaluation() {
+    let e2 = &report().e2;
+    assert_eq!(e2.len(), paper::E2_SAMPLES);
+    let (k_first, _) = e2_direct(e2[0].tensions);
+    let (k_last, _) = e2_direct(e2[e2.len() - 1].tensions);
+    let (mut worst_report, mut worst_line, mut worst_torque) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for p in e2 {
+        let (k, tau) = e2_direct(p.tensions);
+        // The tensions hold E2's torque.
+        let torque_err = (tau - nalgebra::Vector2::from(paper::E2_TORQUE)).norm();
+        worst_torque = worst_torque.max(torque_err);
+        // Measured worst 3.2e-15 N m.
+        assert!(torque_err <= 2e-14, "level {}: τ off by {torque_err:e} N m", p.level);
+        // The report's K_x, K_y are the direct ones.
+        let report_err = ((p.k_x - k[(0, 0)]).abs()).max((p.k_y - k[(1, 1)]).abs()) / k.amax();
+        worst_report = worst_report.max(report_err);
+        // The direct K on the line between the direct ends.
+        let line = k_first + (k_last - k_first) * p.level;
+        let line_err = (k - line).amax() / k.amax();
+        worst_line = worst_line.max(line_err);
+        // Measured worst 2.7e-16 for both.
+        assert!(report_err <= 2e-15, "level {}: report's K off by {report_err:e}", p.level);
+        assert!(line_err <= 2e-15, "level {}: K off the line by {line_err:e}", p.level);
+    }
+    println!(
+        "E2: worst |τ − τ_E2| {worst_torque:.2e} N m, report vs direct K {worst_report:.2e}, \
+         direct K vs line {worst_line:.2e}"
+    );
+    // And it rises: K_x, K_y both stiffer at the top of the segment.
+    assert!(k_last[(0, 0)] > k_first[(0, 0)] + 1.0 && k_last[(1, 1)] > k_first[(1, 1)] + 1.0);
 }
 
 #[test]

@@ -176,13 +176,26 @@ fn routing_json_equals_the_library_in_both_models() {
 // joint
 
 fn check_joint(fx: &Fixture, joint: usize, q: [f64; 2], tau: [f64; 2]) {
+    check_joint_in(fx, "decoupled", joint, q, tau);
+}
+
+/// The fixture's routing of a model (`decoupled` or `routed`).
+fn routing_of<'a>(fx: &'a Fixture, model: &str) -> &'a Routing {
+    if model == "routed" { &fx.routed } else { &fx.routing }
+}
+
+/// `sinew joint … --model <model> --json` against the library's probe on that model's routing;
+/// returns the document.
+fn check_joint_in(fx: &Fixture, model: &str, joint: usize, q: [f64; 2], tau: [f64; 2]) -> Value {
     let number = (joint + 1).to_string();
     let (qs, ts) = (list(&q), list(&tau));
     let args = ["joint", "--robot", fx.path(), "--joint", &number, "--q", &qs, "--torque", &ts];
-    let doc = json(&[&args[..], &["--json"]].concat());
-    let mut probe = JointProbe::new(&fx.robot, &fx.routing, joint).unwrap();
-    let range = probe.evaluate(&fx.robot, &fx.routing, q, tau).unwrap();
+    let doc = json(&[&args[..], &["--model", model, "--json"]].concat());
+    let routing = routing_of(fx, model);
+    let mut probe = JointProbe::new(&fx.robot, routing, joint).unwrap();
+    let range = probe.evaluate(&fx.robot, routing, q, tau).unwrap();
     assert_eq!(doc["command"], "joint");
+    assert_eq!(doc["model"], model);
     assert_eq!(doc["joint"], joint, "JSON joint is 0-based");
     assert_vec(&doc["q"], &q, "q");
     assert_vec(&doc["torque"], &tau, "torque");
@@ -204,8 +217,9 @@ fn check_joint(fx: &Fixture, joint: usize, q: [f64; 2], tau: [f64; 2]) {
         assert_num(&doc[key][1], sigma.delta, key);
     }
     let names: Vec<&str> =
-        fx.routing.cables().iter().filter(|c| c.joint == joint).map(|c| c.name.as_str()).collect();
+        routing.cables().iter().filter(|c| c.joint == joint).map(|c| c.name.as_str()).collect();
     assert_eq!(doc["cables"], serde_json::json!(names));
+    doc
 }
 
 #[test]
@@ -215,6 +229,17 @@ fn joint_json_equals_the_library() {
     check_joint(&fx, 0, [pi6, pi6], [0.3, 0.3]);
     check_joint(&fx, 0, [0.3, -0.2], [0.3, 0.3]);
     check_joint(&fx, 2, [-0.25, 0.1], [-0.5, 0.2]);
+}
+
+#[test]
+fn joint_routed_equals_the_library_and_differs_from_decoupled() {
+    let fx = Fixture::new();
+    let (q, tau) = ([-0.25, 0.1], [-0.5, 0.2]);
+    let routed = check_joint_in(&fx, "routed", 2, q, tau);
+    check_joint_in(&fx, "routed", 4, [0.3, -0.2], [0.3, 0.3]);
+    // `--model routed` is not ignored: joint 3's cables pass joints 1 and 2 there.
+    let decoupled = check_joint_in(&fx, "decoupled", 2, q, tau);
+    assert_ne!(routed["k"], decoupled["k"]);
 }
 
 #[test]
@@ -418,26 +443,44 @@ fn a_rank_deficient_jacobian_reports_the_compliance_only() {
 #[test]
 fn sweep_json_and_csv_equal_the_library() {
     let fx = Fixture::new();
-    let csv = fx.dir.path().join("maps.csv");
+    check_sweep(&fx, "decoupled", 0, [0.3, 0.3]);
+}
+
+#[test]
+fn sweep_routed_equals_the_library() {
+    let fx = Fixture::new();
+    check_sweep(&fx, "routed", 2, [-0.5, 0.2]);
+}
+
+/// `sinew sweep … --model <model> --grid 5 --out maps.csv --json` against the library's sweep
+/// on that model's routing: the JSON maps and the CSV file.
+fn check_sweep(fx: &Fixture, model: &str, joint: usize, tau: [f64; 2]) {
+    let csv = fx.dir.path().join(format!("maps-{model}.csv"));
     let csv_arg = csv.to_str().unwrap();
+    let (number, ts) = ((joint + 1).to_string(), list(&tau));
     let doc = json(&[
         "sweep",
         "--robot",
         fx.path(),
+        "--model",
+        model,
         "--joint",
-        "1",
+        &number,
         "--torque",
-        "0.3,0.3",
+        &ts,
         "--grid",
         "5",
         "--out",
         csv_arg,
         "--json",
     ]);
-    let x = &fx.robot.joints()[0];
+    let x = &fx.robot.joints()[2 * joint];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 5 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap();
-    assert_eq!(doc["joint"], 0);
+    let routing = routing_of(fx, model);
+    let maps = sweep_joint(&fx.robot, routing, joint, tau, grid, &|_, _| {}).unwrap();
+    assert!(maps.feasible() > 0, "{model}: nothing to compare");
+    assert_eq!(doc["model"], model);
+    assert_eq!(doc["joint"], joint);
     assert_eq!(doc["grid"]["points"], 5);
     let angles: Vec<f64> = (0..5).map(|k| grid.angle(k)).collect();
     assert_vec(&doc["grid"]["angles"], &angles, "angles");
@@ -464,7 +507,8 @@ fn sweep_json_and_csv_equal_the_library() {
 
 #[test]
 fn sweep_marks_infeasible_points_null() {
-    // A torque that only part of the grid can hold (or none of it): nulls, not errors.
+    // A torque that only part of the grid can hold (6 of 9 points; 6 N m held all 9, so the
+    // old case checked no null): nulls, not errors, beside numbers.
     let fx = Fixture::new();
     let doc = json(&[
         "sweep",
@@ -473,17 +517,60 @@ fn sweep_marks_infeasible_points_null() {
         "--joint",
         "2",
         "--torque",
-        "6,0",
+        "10,0",
         "--grid",
         "3",
         "--json",
     ]);
     let x = &fx.robot.joints()[2];
     let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 3 };
-    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [6.0, 0.0], grid, &|_, _| {}).unwrap();
+    let maps = sweep_joint(&fx.robot, &fx.routing, 1, [10.0, 0.0], grid, &|_, _| {}).unwrap();
     assert_eq!(doc["feasible"], maps.feasible());
-    let nulls = doc["k_x_min"].as_array().unwrap().iter().flat_map(|r| r.as_array().unwrap());
-    assert_eq!(nulls.filter(|v| v.is_null()).count(), 9 - maps.feasible());
+    // Mixed: both kinds present, or the check below proves nothing.
+    assert!(0 < maps.feasible() && maps.feasible() < 9, "{} of 9 feasible", maps.feasible());
+    for key in ["k_x_min", "k_x_max", "k_y_min", "k_y_max"] {
+        for a in 0..3 {
+            for b in 0..3 {
+                let v = &doc[key][a][b];
+                match maps.cell(a, b) {
+                    Some(_) => assert!(v.is_f64(), "{key}[{a}][{b}] a number where feasible"),
+                    None => assert!(v.is_null(), "{key}[{a}][{b}] null where infeasible"),
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn sweep_out_without_json_writes_the_csv_and_prints_tables() {
+    let fx = Fixture::new();
+    let csv = fx.dir.path().join("tables.csv");
+    let csv_arg = csv.to_str().unwrap();
+    let args = [
+        "sweep",
+        "--robot",
+        fx.path(),
+        "--joint",
+        "1",
+        "--torque",
+        "0.3,0.3",
+        "--grid",
+        "4",
+        "--out",
+        csv_arg,
+    ];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(serde_json::from_str::<Value>(&text).is_err(), "tables, not JSON:\n{text}");
+    assert!(text.contains(&format!("wrote {csv_arg} (16 rows)")), "{text}");
+    assert!(text.contains("K_x max"), "{text}");
+    // With --out the per-point maps go to the file, not to the terminal.
+    assert!(!text.contains("rows q1, columns q2"), "{text}");
+    let x = &fx.robot.joints()[0];
+    let grid = AngleGrid { lower: x.lower, upper: x.upper, points: 4 };
+    let maps = sweep_joint(&fx.robot, &fx.routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap();
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), e3_csv(&maps));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -627,6 +714,37 @@ fn a_robot_folder_without_its_files_is_named() {
         &["routing", "--robot", fx.path(), "--model", "routed"],
         2,
         &[sinew::routing::ROUTED_ROUTING_FILE],
+    );
+}
+
+#[test]
+fn a_malformed_routing_file_is_one_line_with_exit_2() {
+    let fx = Fixture::new();
+    let r = fx.path();
+    let q = list(&[0.0; 10]);
+    // Not TOML: the parser's multi-line report folds into one line naming the file.
+    std::fs::write(fx.dir.path().join("cables.toml"), "tension_limits = [20.0, 600.0\n[material\n")
+        .unwrap();
+    for args in [
+        vec!["routing", "--robot", r],
+        vec!["arm", "--robot", r, "--q", &q],
+        vec!["joint", "--robot", r, "--joint", "1", "--q", "0,0", "--torque", "0,0"],
+        vec!["sweep", "--robot", r, "--joint", "1", "--torque", "0,0", "--grid", "3"],
+    ] {
+        assert_fails(&args, 2, &["cables.toml", "invalid routing file"]);
+    }
+    // Valid TOML, an invalid value: named by its field.
+    std::fs::write(
+        fx.dir.path().join("cables-routed.toml"),
+        std::fs::read_to_string(sinew_testkit::cdhrm5::dir().join("cables-routed.toml"))
+            .unwrap()
+            .replacen("tension_limits = [20.0, 600.0]", "tension_limits = [600.0, 20.0]", 1),
+    )
+    .unwrap();
+    assert_fails(
+        &["routing", "--robot", r, "--model", "routed"],
+        2,
+        &["cables-routed.toml", "tension_limits"],
     );
 }
 

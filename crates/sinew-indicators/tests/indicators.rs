@@ -107,6 +107,28 @@ fn bad_probes_and_grids_are_errors() {
 }
 
 #[test]
+fn a_joint_without_exactly_three_cables_is_named() {
+    // One joint driven by four cables: the single-joint model (eq. 22–23) cannot take it.
+    let robot = cdhrm5::chain_robot(1);
+    let mut text = String::from(
+        "tension_limits = [20.0, 600.0]\nfree_length = 3.0\n[material]\nyoungs_modulus = 12.5e9\ndiameter = 1e-3\n",
+    );
+    for (k, angle) in [0.0_f64, 1.5, 3.0, 4.5].iter().enumerate() {
+        let (x, y) = (0.022 * angle.cos(), 0.022 * angle.sin());
+        text += &format!(
+            "[[cable]]\nname = \"c{k}\"\nholes = [{{ link = \"base_link\", point = [{x}, {y}, 0.0] }}, {{ link = \"link1\", point = [{x}, {y}, 0.0] }}]\n"
+        );
+    }
+    let routing = Routing::from_toml_str(&text, "four.toml", &robot).unwrap();
+    let err = JointProbe::new(&robot, &routing, 0).unwrap_err();
+    assert!(matches!(err, IndicatorError::NotThreeCables { joint: 0, cables: 4 }), "{err:?}");
+    assert!(err.to_string().starts_with("joint 1 has 4 cables of its own"), "{err}");
+    let grid = AngleGrid { lower: -0.1, upper: 0.1, points: 3 };
+    let err = sweep_joint(&robot, &routing, 0, [0.3, 0.3], grid, &|_, _| {}).unwrap_err();
+    assert!(matches!(err, IndicatorError::NotThreeCables { joint: 0, cables: 4 }), "{err:?}");
+}
+
+#[test]
 fn sweep_reports_progress_up_to_the_total() {
     use std::sync::Mutex;
     let (robot, routing) = cdhrm5();

@@ -179,6 +179,86 @@ fn duplicate_link() {
 }
 
 #[test]
+fn duplicate_joint() {
+    let extra = r#"<link name="l2"/><joint name="j2" type="fixed"><parent link="tip"/><child link="l2"/></joint>"#;
+    let err = load(&urdf("revolute", "base", "1 0 0", "0.5", extra)).unwrap_err();
+    assert!(
+        matches!(err, RobotError::DuplicateJoint { ref joint, .. } if joint == "j2"),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "test.urdf: joint `j2` is defined twice");
+}
+
+#[test]
+fn non_finite_urdf_values_name_the_element_and_field() {
+    // A joint origin.
+    let text = valid().replacen(r#"<origin xyz="0 0 0.2"/>"#, r#"<origin xyz="0 0 inf"/>"#, 1);
+    let err = load(&text).unwrap_err();
+    assert!(
+        matches!(err, RobotError::NonFinite { ref element, ref field, .. } if element == "joint `j2`" && field == "origin"),
+        "{err:?}"
+    );
+    assert_eq!(err.to_string(), "test.urdf: joint `j2`: `origin` is not finite");
+    // A joint axis.
+    let err = load(&urdf("revolute", "base", "nan 0 1", "0.5", "")).unwrap_err();
+    assert_eq!(err.to_string(), "test.urdf: joint `j1`: `axis` is not finite");
+    // A link's inertia and its inertial origin.
+    let err = load(&valid().replacen(r#"ixx="1e-3""#, r#"ixx="NaN""#, 1)).unwrap_err();
+    assert!(matches!(err, RobotError::NonFinite { .. }), "{err:?}");
+    assert_eq!(err.to_string(), "test.urdf: link `l1` inertial: `inertia` is not finite");
+    let err = load(&valid().replacen(r#"xyz="0 0 0.1"/><mass"#, r#"xyz="0 -inf 0.1"/><mass"#, 1))
+        .unwrap_err();
+    assert_eq!(err.to_string(), "test.urdf: link `l1` inertial: `origin` is not finite");
+}
+
+#[test]
+fn non_finite_gravity_in_the_description() {
+    let dir = std::env::temp_dir().join(format!("sinew-nan-gravity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("robot.toml"),
+        "urdf = \"x.urdf\"\ntip_link = \"tip\"\ngravity = [0.0, 0.0, nan]\n",
+    )
+    .unwrap();
+    let err = sinew_robot::RobotDescription::read(&dir).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(
+        matches!(err, RobotError::InvalidGravity { gravity, .. } if gravity[2].is_nan()),
+        "{err:?}"
+    );
+    let message = err.to_string();
+    assert!(message.contains("robot.toml") && message.contains("gravity"), "{message}");
+}
+
+#[test]
+fn a_body_index_the_robot_does_not_have() {
+    let robot = load(&valid()).unwrap();
+    let mut data = RobotData::new(&robot);
+    robot.forward_kinematics(&mut data, &[0.0, 0.0]).unwrap();
+    let bodies = robot.bodies().len();
+    let point = sinew_robot::BodyPoint { body: bodies + 7, point: Vector3::zeros() };
+    let err = robot.point_position(&data, &point).unwrap_err();
+    assert!(matches!(err, RobotError::NoSuchBody { body, .. } if body == bodies + 7), "{err:?}");
+    assert_eq!(
+        err.to_string(),
+        format!("body index {} is out of range: the robot has {bodies} bodies", bodies + 7)
+    );
+}
+
+#[test]
+fn a_wrong_size_output_names_what_was_passed() {
+    let robot = load(&valid()).unwrap();
+    let mut data = RobotData::new(&robot);
+    robot.forward_kinematics(&mut data, &[0.0, 0.0]).unwrap();
+    let err = robot.forward_kinematics(&mut data, &[0.0; 3]).unwrap_err();
+    assert!(err.to_string().ends_with("expected 2 entries, got 3"), "{err}");
+    let mut t = vec![0.0; 5];
+    let err = robot.gravity_torque(&mut data, &mut t).unwrap_err();
+    assert!(matches!(err, RobotError::DimensionMismatch { expected: 2, got: 5, .. }), "{err:?}");
+    assert!(err.to_string().ends_with("expected 2 entries, got 5"), "{err}");
+}
+
+#[test]
 fn inverted_limits() {
     let text = valid().replacen(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#, 1);
     let err = load(&text).unwrap_err();
@@ -230,10 +310,13 @@ fn workspace_of_another_robot() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(512))]
 
-    /// Arbitrary text never panics the loader.
+    /// Arbitrary text never panics the loader; what it rejects it names in one line.
     #[test]
     fn arbitrary_text_never_panics(text in any::<String>()) {
-        let _ = load(&text);
+        match load(&text) {
+            Err(err) => assert_one_line_naming_the_source(&err),
+            Ok(robot) => assert_evaluates_finitely(&robot),
+        }
     }
 
     /// URDF-looking text: the valid file with a slice cut out and a token spliced in.
@@ -250,14 +333,41 @@ proptest! {
         let mut end = (start + len).min(text.len());
         while !text.is_char_boundary(end) { end -= 1; }
         let mutated = format!("{}{}{}", &text[..start], token, &text[end..]);
-        if let Ok(robot) = load(&mutated) {
-            // Whatever loads evaluates without a panic or a NaN.
-            let mut data = RobotData::new(&robot);
-            let q = vec![0.1; robot.dof()];
-            robot.forward_kinematics(&mut data, &q).unwrap();
-            let mut t = vec![0.0; robot.dof()];
-            robot.gravity_torque(&mut data, &mut t).unwrap();
-            prop_assert!(t.iter().all(|x| x.is_finite()));
+        match load(&mutated) {
+            Err(err) => assert_one_line_naming_the_source(&err),
+            Ok(robot) => assert_evaluates_finitely(&robot),
         }
+    }
+}
+
+/// A loader error is one non-empty line that names the file (`test.urdf`), or, for a tip link
+/// the chain does not have, the robot and the link asked for.
+fn assert_one_line_naming_the_source(err: &RobotError) {
+    let message = err.to_string();
+    assert!(!message.trim().is_empty() && !message.contains('\n'), "{message:?}");
+    match err {
+        RobotError::NoSuchLink { link, .. } => {
+            assert!(message.contains(&format!("`{link}`")), "{message}");
+        }
+        _ => assert!(message.starts_with("test.urdf: "), "{message}"),
+    }
+}
+
+/// Whatever loads evaluates without a panic or a NaN: positions, the tip Jacobian, the
+/// gravity torque and its derivative.
+fn assert_evaluates_finitely(robot: &Robot) {
+    let n = robot.dof();
+    let mut data = RobotData::new(robot);
+    let q = vec![0.1; n];
+    robot.forward_kinematics(&mut data, &q).unwrap();
+    let mut t = vec![0.0; n];
+    robot.gravity_torque(&mut data, &mut t).unwrap();
+    assert!(t.iter().all(|x| x.is_finite()), "{t:?}");
+    let mut j = faer::Mat::zeros(6, n);
+    robot.point_jacobian(&data, &robot.tip_point(), j.as_mut()).unwrap();
+    let mut k = faer::Mat::zeros(n, n);
+    robot.gravity_torque_derivative(&mut data, k.as_mut()).unwrap();
+    for m in [&j, &k] {
+        assert!((0..m.ncols()).all(|c| (0..m.nrows()).all(|r| m[(r, c)].is_finite())));
     }
 }

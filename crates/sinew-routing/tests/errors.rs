@@ -339,16 +339,46 @@ fn odd_revolute_count() {
 /// Load `text`; when it loads, evaluate it at Q = 0 and at a bent configuration. Nothing may
 /// panic, and a routing that loads has finite, positive stiffness.
 fn load_and_evaluate(robot: &Robot, text: &str) {
-    if let Ok(routing) = Routing::from_toml_str(text, "<prop>", robot) {
-        assert!(routing.cable_stiffness().iter().all(|k| k.is_finite() && *k > 0.0));
-        let mut rdata = RobotData::new(robot);
-        let mut data = RoutingData::new(&routing);
-        for q in [0.0, 0.4] {
-            let q = vec![q; robot.dof()];
-            if compute_cable_geometry(&routing, robot, &mut rdata, &mut data, &q, Order::Hessians)
-                .is_ok()
-            {
+    let routing = match Routing::from_toml_str(text, "<prop>", robot) {
+        Ok(routing) => routing,
+        Err(err) => {
+            // A rejected file: a non-empty headline that names it, on one line; only a TOML
+            // parse error adds lines (the parser's quoted excerpt, which the CLI folds into
+            // one line, see crates/sinew-cli's `one_line`).
+            let message = err.to_string();
+            let headline = message.lines().next().unwrap_or_default();
+            assert!(headline.starts_with("<prop>: ") && headline.len() > 8, "{message:?}");
+            if !matches!(err, RoutingError::Parse { .. }) {
+                assert!(!message.contains('\n'), "{message:?}");
+            }
+            return;
+        }
+    };
+    assert!(routing.cable_stiffness().iter().all(|k| k.is_finite() && *k > 0.0));
+    let mut rdata = RobotData::new(robot);
+    let mut data = RoutingData::new(&routing);
+    let n = robot.dof();
+    let mut hessian = faer::Mat::zeros(n, n);
+    for q in [0.0, 0.4] {
+        let q = vec![q; n];
+        match compute_cable_geometry(&routing, robot, &mut rdata, &mut data, &q, Order::Hessians) {
+            Ok(()) => {
+                // Whatever evaluates is finite: lengths, J_c, every cable's Hessian.
                 assert!(data.lengths().unwrap().iter().all(|l| l.is_finite()));
+                let j = data.jacobian().unwrap();
+                assert!((0..n).all(|d| (0..j.nrows()).all(|c| j[(c, d)].is_finite())));
+                for c in 0..routing.cable_count() {
+                    data.cable_hessian(&routing, c, hessian.as_mut()).unwrap();
+                    assert!(
+                        (0..n).all(|a| (0..n).all(|b| hessian[(a, b)].is_finite())),
+                        "cable {c}: non-finite Hessian"
+                    );
+                }
+            }
+            Err(err) => {
+                // A configuration the routing cannot take: one line naming the cable.
+                let message = err.to_string();
+                assert!(!message.contains('\n') && message.contains("cable `"), "{message:?}");
             }
         }
     }

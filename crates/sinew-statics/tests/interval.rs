@@ -25,29 +25,57 @@ fn joint_block(rng: &mut ChaCha8Rng) -> Matrix3x2<f64> {
 fn every_level_balances_the_torque_and_the_ends_are_exact() {
     let mut rng = config::rng(21);
     let mut checked = 0;
+    let mut overshoot = f64::NEG_INFINITY;
+    let (mut worst_residual, mut worst_limit, mut narrowest) = (0.0_f64, 0.0_f64, f64::INFINITY);
+    let outside = |f: Vector3<f64>| f.iter().any(|x| !(LIMITS.f_min..=LIMITS.f_max).contains(x));
     for _ in 0..1000 {
         let jacobian = joint_block(&mut rng);
         let tau = Vector2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
         let Ok(interval) = tension_interval(0, &jacobian, &tau, LIMITS) else { continue };
         checked += 1;
-        assert!(interval.lambda_min <= interval.lambda_max);
+        // A feasible interval is a segment, not a point: `lambda_min <= lambda_max` alone
+        // would accept a collapsed one.
+        assert!(interval.width() > 0.0, "collapsed interval {interval:?}");
+        narrowest = narrowest.min(interval.width());
         assert!(interval.null.min() > 0.0);
+        // The null direction is one: J_cᵀ n = 0, |n| = 1.
+        assert!((jacobian.transpose() * interval.null).norm() <= 1e-15, "Jᵀ n ≠ 0");
         for s in [0.0, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0] {
             let f = interval.tensions_at_level(s);
             let residual = (tau + jacobian.transpose() * f).norm();
-            assert!(residual <= 1e-9, "residual {residual:e} at level {s}");
+            worst_residual = worst_residual.max(residual);
+            // Old bound 1e-9 N m; measured worst 7.1e-15 (|Jᵀ f| ≤ ~20 N m, ε ≈ 2.2e-16).
+            assert!(residual <= 1e-13, "residual {residual:e} at level {s}");
             for k in 0..3 {
-                assert!(f[k] >= LIMITS.f_min - 1e-9 && f[k] <= LIMITS.f_max + 1e-9, "f = {f:?}");
+                overshoot = overshoot.max(LIMITS.f_min - f[k]).max(f[k] - LIMITS.f_max);
+                // Old bound 1e-9 N; measured worst 1.1e-13 N.
+                assert!(f[k] >= LIMITS.f_min - 1e-12 && f[k] <= LIMITS.f_max + 1e-12, "f = {f:?}");
             }
         }
         let (low, high) = interval.ends();
-        let on_limit = |f: Vector3<f64>| {
-            f.iter().any(|&x| (x - LIMITS.f_min).abs() <= 1e-9 || (x - LIMITS.f_max).abs() <= 1e-9)
+        let distance_to_limit = |f: Vector3<f64>| {
+            f.iter()
+                .map(|&x| (x - LIMITS.f_min).abs().min((x - LIMITS.f_max).abs()))
+                .fold(f64::INFINITY, f64::min)
         };
-        assert!(on_limit(low) && on_limit(high), "ends {low:?} {high:?} not on a limit");
+        worst_limit = worst_limit.max(distance_to_limit(low)).max(distance_to_limit(high));
+        // Old bound 1e-9 N; measured worst 1.1e-13 N (600 N · ε).
+        assert!(
+            distance_to_limit(low) <= 1e-12 && distance_to_limit(high) <= 1e-12,
+            "ends {low:?} {high:?} not on a limit"
+        );
+        // The ends are the widest: one step beyond either leaves the limits.
+        let step = 1e-6 * (1.0 + interval.lambda_max.abs().max(interval.lambda_min.abs()));
+        assert!(outside(interval.tensions(interval.lambda_min - step)), "λ_min is not the end");
+        assert!(outside(interval.tensions(interval.lambda_max + step)), "λ_max is not the end");
         // The lower end has the least total tension.
-        assert!(low.sum() <= high.sum());
+        assert!(low.sum() < high.sum());
     }
+    println!(
+        "{checked} feasible: worst |τ + Jᵀ f| = {worst_residual:.2e} N m, worst end-to-limit \
+         distance {worst_limit:.2e} N, narrowest width {narrowest:.2e}"
+    );
+    println!("largest step beyond a limit {overshoot:.2e} N");
     assert!(checked > 500, "only {checked} of 1000 random joints were feasible");
 }
 
