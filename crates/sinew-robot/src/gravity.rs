@@ -13,8 +13,8 @@
 //! ```
 //!
 //! Both are computed by one backward sweep (`O(dof)`) plus `O(dof²)` for the matrix; the
-//! generators `a_k`, `u_k = g × w_k` alone cost `O(dof)`
-//! ([`Robot::gravity_torque_derivative_generators`]).
+//! generators `a_k`, `u_k = g × w_k` alone cost `O(dof)` (sinew-statics forms them from
+//! [`Robot::mass_moments`], with the load's, in one pass).
 
 use faer::MatMut;
 use nalgebra::Vector3;
@@ -109,40 +109,6 @@ impl Robot {
                 out[(j, i)] = value;
                 out[(i, j)] = value;
             }
-        }
-        Ok(())
-    }
-
-    /// The generators of `∂T_g/∂Q`: `u_k = g × (a_k × r_k)` (base frame, N m), one per joint,
-    /// into `out` (length dof).
-    ///
-    /// # Math
-    /// `∂T_g[j]/∂q_i = a_min(i,j) · u_max(i,j)` (see the module docs): the dof × dof matrix
-    /// [`Robot::gravity_torque_derivative`] is semiseparable, every entry a dot product of two
-    /// 3-vectors, the axis of the proximal joint and the generator of the distal one. Structured
-    /// solvers use the `2 · dof` vectors `a_k`, `u_k` instead of the `dof²` entries.
-    ///
-    /// Needs [`Robot::forward_kinematics`] first. `O(dof)`, no allocation.
-    ///
-    /// # Errors
-    /// [`RobotError::WorkspaceMismatch`], [`RobotError::DimensionMismatch`].
-    pub fn gravity_torque_derivative_generators(
-        &self,
-        data: &mut RobotData,
-        out: &mut [Vector3<f64>],
-    ) -> Result<()> {
-        data.check(self)?;
-        if out.len() != self.dof() {
-            return Err(RobotError::DimensionMismatch {
-                what: "gravity torque derivative generators",
-                expected: self.dof(),
-                got: out.len(),
-            });
-        }
-        self.accumulate_mass_moments(data);
-        let g = self.gravity;
-        for (k, u) in out.iter_mut().enumerate() {
-            *u = g.cross(&data.o_axis[k].cross(&data.o_mass_moment[k]));
         }
         Ok(())
     }
