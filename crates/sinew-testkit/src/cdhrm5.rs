@@ -129,18 +129,8 @@ pub fn chain_routing_spec(chain: &UniformChain, model: PatternModel) -> RoutingS
             distal_radius: None,
             theta0: THETA0,
             joint_offset: JOINT_OFFSET,
-            proximal_discs: (1..=n)
-                .map(
-                    |i| {
-                        if i == 1 {
-                            "base_link".to_owned()
-                        } else {
-                            format!("link{}_distal", i - 1)
-                        }
-                    },
-                )
-                .collect(),
-            distal_discs: (1..=n).map(|i| format!("link{i}")).collect(),
+            proximal_discs: proximal_discs(n),
+            distal_discs: distal_discs(n),
         }),
         cables: Vec::new(),
     }
@@ -179,4 +169,17 @@ pub fn cases(joints: usize) -> Vec<(String, Robot, Routing)> {
         cases.push((format!("uniform{joints} {model:?}"), robot, routing));
     }
     cases
+}
+
+/// The proximal disc of each of `n` universal joints in the cdhrm5 link naming (also the
+/// generated chains'): `base_link`, then `link{i}_distal`.
+pub fn proximal_discs(n: usize) -> Vec<String> {
+    (1..=n)
+        .map(|i| if i == 1 { "base_link".to_owned() } else { format!("link{}_distal", i - 1) })
+        .collect()
+}
+
+/// The distal disc of each of `n` universal joints in the cdhrm5 link naming: `link{i}`.
+pub fn distal_discs(n: usize) -> Vec<String> {
+    (1..=n).map(|i| format!("link{i}")).collect()
 }

@@ -330,16 +330,8 @@ impl RandomChain {
                 distal_radius: None,
                 theta0: 0.1,
                 joint_offset: std::f64::consts::TAU / 15.0,
-                proximal_discs: (1..=n)
-                    .map(|i| {
-                        if i == 1 {
-                            "base_link".to_owned()
-                        } else {
-                            format!("link{}_distal", i - 1)
-                        }
-                    })
-                    .collect(),
-                distal_discs: (1..=n).map(|i| format!("link{i}")).collect(),
+                proximal_discs: crate::cdhrm5::proximal_discs(n),
+                distal_discs: crate::cdhrm5::distal_discs(n),
             }),
             ..self.common_spec(PerJoint::Uniform(3.0))
         }
