@@ -121,6 +121,7 @@ fn statics_kind(e: &StaticsError) -> ErrorKind {
         // Whatever the reason: a rank-deficient joint block, lost force closure, or limits.
         StaticsError::Infeasible { .. } => ErrorKind::Infeasible,
         StaticsError::NonFiniteTorque { .. }
+        | StaticsError::NoSuchJoint { .. }
         | StaticsError::InvalidLevel { .. }
         | StaticsError::UnsupportedRouting { .. }
         | StaticsError::DimensionMismatch { .. }

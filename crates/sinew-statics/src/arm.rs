@@ -116,8 +116,8 @@ impl ArmStatics {
     /// the same `Q` first. No allocation.
     ///
     /// # Errors
-    /// [`StaticsError::DimensionMismatch`]; [`StaticsError::Infeasible`] for a rank-deficient
-    /// proximal joint.
+    /// [`StaticsError::NoSuchJoint`], [`StaticsError::DimensionMismatch`];
+    /// [`StaticsError::Infeasible`] for a rank-deficient proximal joint.
     pub fn tension_sensitivity(
         &self,
         routing_data: &RoutingData,
@@ -127,11 +127,7 @@ impl ArmStatics {
     ) -> Result<(), StaticsError> {
         let n = self.layout.joints();
         if joint >= n {
-            return Err(StaticsError::DimensionMismatch {
-                what: "joint index",
-                expected: n,
-                got: joint,
-            });
+            return Err(StaticsError::NoSuchJoint { joint, joints: n });
         }
         if out.len() != 3 * n {
             return Err(StaticsError::DimensionMismatch {

@@ -151,6 +151,14 @@ pub enum StaticsError {
     /// A routing that is not three cables per universal joint (each cable driving one joint).
     #[error("unsupported routing: {0}")]
     UnsupportedRouting(UnsupportedRouting),
+    /// A joint index beyond the arm's universal joints.
+    #[error("joint {} does not exist: the arm has {joints} universal joints", .joint + 1)]
+    NoSuchJoint {
+        /// The joint asked for (0-based; the message counts from 1).
+        joint: usize,
+        /// The number of universal joints.
+        joints: usize,
+    },
     /// An input of the wrong size.
     #[error("{what}: expected {expected} entries, got {got}")]
     DimensionMismatch {
