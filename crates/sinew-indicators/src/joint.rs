@@ -129,12 +129,8 @@ impl JointProbe {
         }
         let [f_min, f_max] = routing.tension_limits();
         let n = robot.dof();
-        let crossing = routing
-            .cables()
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| c.dofs.contains(&(2 * joint)) || c.dofs.contains(&(2 * joint + 1)))
-            .map(|(k, _)| k)
+        let crossing = (0..routing.cable_count())
+            .filter(|&c| routing.cable_joint_span(c).is_some_and(|span| span.contains(&joint)))
             .collect();
         Ok(JointProbe {
             joint,
