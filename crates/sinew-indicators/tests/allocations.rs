@@ -22,7 +22,7 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 fn evaluating_the_indicators_allocates_nothing() {
     assert_counting();
     probe_evaluations_allocate_nothing();
-    an_infeasible_probe_allocates_nothing();
+    an_infeasible_probe_allocates_only_its_boxed_error();
     the_ellipsoid_allocates_nothing();
 }
 
@@ -62,7 +62,7 @@ fn probe_evaluations_allocate_nothing() {
     }
 }
 
-fn an_infeasible_probe_allocates_nothing() {
+fn an_infeasible_probe_allocates_only_its_boxed_error() {
     // Apart from the feasible evaluations, so that a failure says which path allocates.
     let (robot, routing) = cdhrm5::robot_and_routing(cdhrm5::MODELS[0]);
     let mut probe = JointProbe::new(&robot, &routing, 0).unwrap();
