@@ -17,7 +17,7 @@ use sinew_statics::ArmStatics;
 use crate::data::ArmStiffnessData;
 use crate::end::end_compliance;
 use crate::error::StiffnessError;
-use crate::joint::{joint_stiffness_in_blocks, stiffness_slope};
+use crate::joint::{InherentPlan, joint_stiffness_in_blocks, stiffness_slope};
 use crate::structured::{self, BlockLayout, Structured};
 
 /// The model of the pipeline `Q → K_x`: the robot and its routing, the statics solver checked
@@ -29,6 +29,7 @@ pub struct ArmStiffness {
     routing: Routing,
     statics: ArmStatics,
     layout: BlockLayout,
+    inherent: InherentPlan,
 }
 
 /// Which solver computed the end compliance of the last evaluation
@@ -59,6 +60,7 @@ impl ArmStiffness {
         Ok(ArmStiffness {
             statics: ArmStatics::new(routing)?,
             layout: BlockLayout::new(routing),
+            inherent: InherentPlan::new(routing),
             robot: robot.clone(),
             routing: routing.clone(),
         })
@@ -92,6 +94,10 @@ impl ArmStiffness {
 
     pub(crate) fn layout(&self) -> &BlockLayout {
         &self.layout
+    }
+
+    pub(crate) fn inherent_plan(&self) -> &InherentPlan {
+        &self.inherent
     }
 
     /// Check that `data` was made for this arm (by [`ArmStiffnessData::new`]), as Pinocchio's
@@ -153,6 +159,7 @@ impl ArmStiffness {
             &data.cables,
             &data.statics.tensions,
             &self.layout,
+            (&self.inherent, &mut data.inherent),
             &mut data.k_controllable,
             &mut data.k_inherent,
             &mut data.k_q,
