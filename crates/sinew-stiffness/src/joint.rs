@@ -97,7 +97,12 @@ pub(crate) fn joint_stiffness_in_blocks(
     }
     if !layout.structured() {
         zero_blocks(layout, controllable);
-        geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
+        add_weighted_hessians(
+            routing,
+            geometry.segment_hessians(routing)?,
+            tensions,
+            controllable,
+        )?;
         zero_blocks(layout, inherent);
         plan.add_upper(geometry.jacobian()?, scratch, inherent)?;
         mirror_upper(inherent.as_mut(), layout.blocks());
@@ -234,6 +239,43 @@ fn add_inherent_upper(
     Ok(())
 }
 
+/// `out += Σ_c f_c H_c` segment by segment, each block column by column: the sums of
+/// [`RoutingData::add_weighted_hessians`] in the same order, written through column slices.
+fn add_weighted_hessians(
+    routing: &Routing,
+    hessians: SegmentHessians<'_>,
+    tensions: &[f64],
+    out: &mut ColMajor,
+) -> Result<(), StiffnessError> {
+    for (s, (seg, h)) in hessians.iter().enumerate() {
+        let (lo, n) = (seg.dofs.start, seg.dofs.len());
+        if n == 0 {
+            continue;
+        }
+        let Some(&w) = tensions.get(seg.cable) else {
+            return Err(StiffnessError::DimensionMismatch {
+                what: "tensions",
+                expected: routing.cable_count(),
+                got: tensions.len(),
+            });
+        };
+        if h.len() != n * n || lo + n > out.rows() || lo + n > out.cols() {
+            return Err(StiffnessError::DimensionMismatch {
+                what: "segment Hessian",
+                expected: n * n,
+                got: s,
+            });
+        }
+        for (k, h) in h.chunks_exact(n).enumerate() {
+            let col = &mut out.col_mut(lo + k)[lo..lo + n];
+            for (v, h) in col.iter_mut().zip(h) {
+                *v += w * h;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Width of the row blocks of [`InherentPlan::add_upper`]: eight `f64` accumulators, two AVX
 /// registers.
 const LANES: usize = 8;
@@ -325,17 +367,18 @@ impl InherentPlan {
             }
         }
         for (j, (first_row, cables)) in self.columns.iter().enumerate() {
-            let cables = cables.clone();
-            for c in cables.clone() {
-                weights[c] = self.stiffness[c] * rows[c * stride + j];
+            let rows = &rows[cables.start * stride..cables.end * stride];
+            let (weights, stiffness) =
+                (&mut weights[cables.clone()], &self.stiffness[cables.clone()]);
+            for ((w, k), row) in weights.iter_mut().zip(stiffness).zip(rows.chunks_exact(stride)) {
+                *w = k * row[j];
             }
             let col = &mut out.col_mut(j)[..=j];
             let mut block = first_row - first_row % LANES;
             while block <= j {
                 let mut acc = [0.0; LANES];
-                for c in cables.clone() {
-                    let w = weights[c];
-                    let r = &rows[c * stride + block..c * stride + block + LANES];
+                for (&w, row) in weights.iter().zip(rows.chunks_exact(stride)) {
+                    let r = &row[block..block + LANES];
                     for t in 0..LANES {
                         acc[t] += w * r[t];
                     }
