@@ -26,6 +26,7 @@ use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting as lu;
 use faer::{Mat, MatRef, Par, Side};
 use nalgebra::Matrix3;
+use sinew_statics::KwGenerators;
 
 use crate::error::StiffnessError;
 
@@ -247,6 +248,62 @@ pub fn end_compliance(
             }
         }
     }
+    if !factor_and_solve(j_x, symmetric, data) {
+        return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_q, k_w)? });
+    }
+    Ok(())
+}
+
+/// [`end_compliance`] with `K_W` given by its generators (the arm's dense path): `K_W` is
+/// written straight into the storage of `K_q + K_W` (its LU's), which one pass then completes
+/// while forming the lower triangle of the symmetric part for the Cholesky factorisation. The
+/// same sums as [`end_compliance`] with the dense `K_W`, term for term; no dof × dof matrix
+/// besides those two. Returns `Ok(false)` when the symmetric part is not positive definite
+/// (the caller reports the smallest eigenvalue).
+///
+/// # Errors
+/// [`StiffnessError::NonFinite`]; [`StiffnessError::DimensionMismatch`].
+pub(crate) fn end_compliance_generated(
+    k_q: MatRef<'_, f64>,
+    k_w: &KwGenerators,
+    j_x: MatRef<'_, f64>,
+    data: &mut EndStiffnessData,
+) -> Result<bool, StiffnessError> {
+    let n = data.dof;
+    check_square("K_q", k_q, n)?;
+    if j_x.nrows() != 6 || j_x.ncols() != n {
+        let got = if j_x.nrows() != 6 { j_x.nrows() } else { j_x.ncols() };
+        let expected = if j_x.nrows() != 6 { 6 } else { n };
+        return Err(StiffnessError::DimensionMismatch { what: "J_x", expected, got });
+    }
+    k_w.fill_dense(data.a.as_mut()).map_err(|_| StiffnessError::DimensionMismatch {
+        what: "K_W",
+        expected: n,
+        got: k_w.len(),
+    })?;
+    let mut symmetric = true;
+    for j in 0..n {
+        for i in j..n {
+            let l = k_q[(i, j)] + data.a[(i, j)];
+            let u = k_q[(j, i)] + data.a[(j, i)];
+            if !(l.is_finite() && u.is_finite()) {
+                return Err(StiffnessError::NonFinite { what: "K_q + K_W" });
+            }
+            symmetric &= u == l;
+            data.sym[(i, j)] = 0.5 * (u + l);
+            data.a[(i, j)] = l;
+            data.a[(j, i)] = u;
+        }
+    }
+    Ok(factor_and_solve(j_x, symmetric, data))
+}
+
+/// The Cholesky factorisation of `data.sym` (lower triangle: the symmetric part of
+/// `K_q + K_W`), which is the stability verdict; then `X = (K_q + K_W)⁻¹ J_xᵀ` with that factor
+/// when `symmetric`, else with the LU of `data.a` (`K_q + K_W`), and `C_x = J_x X`. `false`
+/// when the factorisation fails (not positive definite).
+fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffnessData) -> bool {
+    let n = data.dof;
     let stack = MemStack::new(&mut data.buffer);
     let stable = llt::factor::cholesky_in_place(
         data.sym.as_mut(),
@@ -257,7 +314,7 @@ pub fn end_compliance(
     )
     .is_ok();
     if !stable {
-        return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_q, k_w)? });
+        return false;
     }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
     for c in 0..6 {
@@ -308,7 +365,7 @@ pub fn end_compliance(
             }
         }
     }
-    Ok(())
+    true
 }
 
 /// `C_x` and then `K_x = C_x⁻¹` (eq. 19) into `data`; read them with
