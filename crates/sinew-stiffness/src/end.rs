@@ -28,6 +28,7 @@ use faer::{Mat, MatRef, Par, Side};
 use nalgebra::Matrix3;
 use sinew_statics::KwGenerators;
 
+use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
 
 /// Relative size below which a pivot of `C_x`'s factorisation counts as zero: the end-effector
@@ -39,9 +40,9 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 pub struct EndStiffnessData {
     dof: usize,
     /// `K_q + K_W`, then its LU factors when it is not symmetric.
-    a: Mat<f64>,
+    a: ColMajor,
     /// Symmetric part of `K_q + K_W`, then its Cholesky factor.
-    sym: Mat<f64>,
+    sym: ColMajor,
     /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6).
     x: Mat<f64>,
     /// `C_x`, column-major 6 × 6.
@@ -64,8 +65,8 @@ impl EndStiffnessData {
         ]);
         EndStiffnessData {
             dof,
-            a: Mat::zeros(dof, dof),
-            sym: Mat::zeros(dof, dof),
+            a: ColMajor::zeros(dof, dof),
+            sym: ColMajor::zeros(dof, dof),
             x: Mat::zeros(dof, 6),
             c_x: [0.0; 36],
             k_x: [0.0; 36],
@@ -236,15 +237,15 @@ pub fn end_compliance(
             }
             symmetric &= u == l;
             let s = 0.5 * (u + l);
-            data.sym[(i, j)] = s;
-            data.sym[(j, i)] = s;
+            *data.sym.at_mut(i, j) = s;
+            *data.sym.at_mut(j, i) = s;
         }
     }
     if !symmetric {
         // K_q + K_W itself, for its LU factorisation.
         for j in 0..n {
             for i in 0..n {
-                data.a[(i, j)] = k_q[(i, j)] + k_w[(i, j)];
+                *data.a.at_mut(i, j) = k_q[(i, j)] + k_w[(i, j)];
             }
         }
     }
@@ -264,13 +265,13 @@ pub fn end_compliance(
 /// # Errors
 /// [`StiffnessError::NonFinite`]; [`StiffnessError::DimensionMismatch`].
 pub(crate) fn end_compliance_generated(
-    k_q: MatRef<'_, f64>,
+    k_q: &ColMajor,
     k_w: &KwGenerators,
     j_x: MatRef<'_, f64>,
     data: &mut EndStiffnessData,
 ) -> Result<bool, StiffnessError> {
     let n = data.dof;
-    check_square("K_q", k_q, n)?;
+    check_square("K_q", k_q.as_ref(), n)?;
     if j_x.nrows() != 6 || j_x.ncols() != n {
         let got = if j_x.nrows() != 6 { j_x.nrows() } else { j_x.ncols() };
         let expected = if j_x.nrows() != 6 { 6 } else { n };
@@ -281,18 +282,22 @@ pub(crate) fn end_compliance_generated(
         expected: n,
         got: k_w.len(),
     })?;
+    // K_q + K_W in place, column by column.
+    for j in 0..n {
+        for (a, k) in data.a.col_mut(j).iter_mut().zip(k_q.col(j)) {
+            *a = k + *a;
+        }
+    }
+    // Finiteness, exact symmetry, the lower triangle of the symmetric part.
     let mut symmetric = true;
     for j in 0..n {
         for i in j..n {
-            let l = k_q[(i, j)] + data.a[(i, j)];
-            let u = k_q[(j, i)] + data.a[(j, i)];
+            let (l, u) = (data.a.at(i, j), data.a.at(j, i));
             if !(l.is_finite() && u.is_finite()) {
                 return Err(StiffnessError::NonFinite { what: "K_q + K_W" });
             }
             symmetric &= u == l;
-            data.sym[(i, j)] = 0.5 * (u + l);
-            data.a[(i, j)] = l;
-            data.a[(j, i)] = u;
+            *data.sym.at_mut(i, j) = 0.5 * (u + l);
         }
     }
     Ok(factor_and_solve(j_x, symmetric, data))
