@@ -285,7 +285,7 @@ pub(crate) fn end_compliance_generated(
     // K_q + K_W in place, column by column.
     for j in 0..n {
         for (a, k) in data.a.col_mut(j).iter_mut().zip(k_q.col(j)) {
-            *a = k + *a;
+            *a += k; // k + a: IEEE addition commutes exactly
         }
     }
     // Finiteness, exact symmetry, the lower triangle of the symmetric part.
