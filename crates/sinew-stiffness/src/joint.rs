@@ -266,6 +266,16 @@ fn add_weighted_hessians(
                 got: s,
             });
         }
+        if let [h00, h10, h01, h11] = *h {
+            // A segment across one universal joint (every routed segment): fixed bounds.
+            let col = &mut out.col_mut(lo)[lo..lo + 2];
+            col[0] += w * h00;
+            col[1] += w * h10;
+            let col = &mut out.col_mut(lo + 1)[lo..lo + 2];
+            col[0] += w * h01;
+            col[1] += w * h11;
+            continue;
+        }
         for (k, h) in h.chunks_exact(n).enumerate() {
             let col = &mut out.col_mut(lo + k)[lo..lo + n];
             for (v, h) in col.iter_mut().zip(h) {
