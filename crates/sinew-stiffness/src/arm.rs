@@ -6,7 +6,7 @@
 //! (Pinocchio's model/data split). When `K_q` is block diagonal with small blocks (the
 //! decoupled model), `C_x` and the stability verdict come from the structured `O(dof)` solve
 //! (`structured/mod.rs` has the derivation); otherwise, or when that solve does not vouch for
-//! its result, from the dense reference ([`end_compliance`]).
+//! its result, from the dense reference ([`crate::end_compliance`]).
 //! [`ArmStiffnessData::end_solver`] tells which one ran.
 
 use nalgebra::Vector6;
@@ -15,9 +15,9 @@ use sinew_routing::{Order, Routing, compute_cable_geometry};
 use sinew_statics::ArmStatics;
 
 use crate::data::ArmStiffnessData;
-use crate::end::end_compliance;
+use crate::end::{end_compliance_generated, stability_margin};
 use crate::error::StiffnessError;
-use crate::joint::{joint_stiffness_in_blocks, stiffness_slope};
+use crate::joint::{InherentPlan, joint_stiffness_in_blocks, stiffness_slope};
 use crate::structured::{self, BlockLayout, Structured};
 
 /// The model of the pipeline `Q → K_x`: the robot and its routing, the statics solver checked
@@ -29,6 +29,7 @@ pub struct ArmStiffness {
     routing: Routing,
     statics: ArmStatics,
     layout: BlockLayout,
+    inherent: InherentPlan,
 }
 
 /// Which solver computed the end compliance of the last evaluation
@@ -41,7 +42,7 @@ pub enum EndSolver {
     /// The structured `O(dof)` solve: `K_q` block diagonal (decoupled model), `K_W`
     /// semiseparable, the result checked by its residual.
     Structured,
-    /// The dense reference [`end_compliance`]: Cholesky of the symmetric part of
+    /// The dense reference [`crate::end_compliance`]: Cholesky of the symmetric part of
     /// `K_q + K_W`, then a Cholesky or LU solve (`O(dof³)`).
     Dense,
 }
@@ -59,6 +60,7 @@ impl ArmStiffness {
         Ok(ArmStiffness {
             statics: ArmStatics::new(routing)?,
             layout: BlockLayout::new(routing),
+            inherent: InherentPlan::new(routing),
             robot: robot.clone(),
             routing: routing.clone(),
         })
@@ -92,6 +94,10 @@ impl ArmStiffness {
 
     pub(crate) fn layout(&self) -> &BlockLayout {
         &self.layout
+    }
+
+    pub(crate) fn inherent_plan(&self) -> &InherentPlan {
+        &self.inherent
     }
 
     /// Check that `data` was made for this arm (by [`ArmStiffnessData::new`]), as Pinocchio's
@@ -153,6 +159,7 @@ impl ArmStiffness {
             &data.cables,
             &data.statics.tensions,
             &self.layout,
+            (&self.inherent, &mut data.inherent),
             &mut data.k_controllable,
             &mut data.k_inherent,
             &mut data.k_q,
@@ -178,9 +185,23 @@ impl ArmStiffness {
             }
         }
         data.solver = EndSolver::Dense;
-        data.fill_k_w();
-        let j_x = data.statics.joint_end().j_x();
-        end_compliance(data.k_q.as_ref(), data.k_w_filled.as_ref(), j_x, &mut data.end)
+        // The dense reference's sums, with K_W written straight into the storage of K_q + K_W
+        // (`end_compliance` with a dense K_W computes the same numbers).
+        let joint_end = data.statics.joint_end();
+        let stable = end_compliance_generated(
+            &data.k_q,
+            joint_end.generators(),
+            joint_end.j_x(),
+            &mut data.end,
+        )?;
+        if stable {
+            Ok(())
+        } else {
+            // Not positive definite: the reference's smallest eigenvalue, from the dense K_W.
+            data.fill_k_w();
+            let min_eigenvalue = stability_margin(data.k_q.as_ref(), data.k_w_filled.as_ref())?;
+            Err(StiffnessError::Unstable { min_eigenvalue })
+        }
     }
 
     /// The whole pipeline `Q → K_x` (eq. 19): [`ArmStiffness::joint_level`], then `C_x` and
@@ -188,7 +209,7 @@ impl ArmStiffness {
     ///
     /// `C_x` comes from the structured `O(dof)` solve when [`ArmStiffness::is_structured`]
     /// (derivation, stability verdict and residual check: `structured/mod.rs`), and from the
-    /// dense reference ([`end_compliance`], `O(dof³)`) otherwise, or when the structured solve
+    /// dense reference ([`crate::end_compliance`], `O(dof³)`) otherwise, or when the structured solve
     /// finds `K_q + K_W` not positive definite (the dense path then reports the smallest
     /// eigenvalue) or its residual check fails. Both give the same results to rounding;
     /// [`ArmStiffnessData::end_solver`] says which ran. `K_x = C_x⁻¹` by a 6 × 6 LU with partial

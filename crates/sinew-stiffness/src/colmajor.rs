@@ -43,6 +43,11 @@ impl ColMajor {
     }
 
     #[inline(always)]
+    pub(crate) fn col(&self, j: usize) -> &[f64] {
+        &self.data[j * self.rows..(j + 1) * self.rows]
+    }
+
+    #[inline(always)]
     pub(crate) fn col_mut(&mut self, j: usize) -> &mut [f64] {
         &mut self.data[j * self.rows..(j + 1) * self.rows]
     }

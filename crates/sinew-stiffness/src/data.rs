@@ -11,7 +11,7 @@ use crate::arm::{ArmStiffness, EndSolver};
 use crate::colmajor::ColMajor;
 use crate::end::{EndStiffnessData, stability_margin};
 use crate::error::StiffnessError;
-use crate::joint::joint_block;
+use crate::joint::{InherentScratch, joint_block};
 use crate::structured::{BlockLayout, StructuredData};
 
 /// Every workspace and result of the pipeline, sized once from an [`ArmStiffness`] (no
@@ -31,6 +31,8 @@ pub struct ArmStiffnessData {
     pub(crate) solver: EndSolver,
     pub(crate) k_controllable: ColMajor,
     pub(crate) k_inherent: ColMajor,
+    /// The workspace of the inherent part's staircase kernel (routed model).
+    pub(crate) inherent: InherentScratch,
     pub(crate) k_q: ColMajor,
     /// The dense `K_W`, written by [`ArmStiffnessData::fill_k_w`] (the dense path, or on
     /// request): the structured solve does not need it.
@@ -53,6 +55,7 @@ impl ArmStiffnessData {
             solver: EndSolver::NotYet,
             k_controllable: ColMajor::zeros(n, n),
             k_inherent: ColMajor::zeros(n, n),
+            inherent: arm.inherent_plan().scratch(),
             k_q: ColMajor::zeros(n, n),
             k_w_filled: ColMajor::zeros(n, n),
             end: EndStiffnessData::new(n),

@@ -26,7 +26,9 @@ use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting as lu;
 use faer::{Mat, MatRef, Par, Side};
 use nalgebra::Matrix3;
+use sinew_statics::KwGenerators;
 
+use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
 
 /// Relative size below which a pivot of `C_x`'s factorisation counts as zero: the end-effector
@@ -38,9 +40,9 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 pub struct EndStiffnessData {
     dof: usize,
     /// `K_q + K_W`, then its LU factors when it is not symmetric.
-    a: Mat<f64>,
+    a: ColMajor,
     /// Symmetric part of `K_q + K_W`, then its Cholesky factor.
-    sym: Mat<f64>,
+    sym: ColMajor,
     /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6).
     x: Mat<f64>,
     /// `C_x`, column-major 6 × 6.
@@ -63,8 +65,8 @@ impl EndStiffnessData {
         ]);
         EndStiffnessData {
             dof,
-            a: Mat::zeros(dof, dof),
-            sym: Mat::zeros(dof, dof),
+            a: ColMajor::zeros(dof, dof),
+            sym: ColMajor::zeros(dof, dof),
             x: Mat::zeros(dof, 6),
             c_x: [0.0; 36],
             k_x: [0.0; 36],
@@ -235,18 +237,78 @@ pub fn end_compliance(
             }
             symmetric &= u == l;
             let s = 0.5 * (u + l);
-            data.sym[(i, j)] = s;
-            data.sym[(j, i)] = s;
+            *data.sym.at_mut(i, j) = s;
+            *data.sym.at_mut(j, i) = s;
         }
     }
     if !symmetric {
         // K_q + K_W itself, for its LU factorisation.
         for j in 0..n {
             for i in 0..n {
-                data.a[(i, j)] = k_q[(i, j)] + k_w[(i, j)];
+                *data.a.at_mut(i, j) = k_q[(i, j)] + k_w[(i, j)];
             }
         }
     }
+    if !factor_and_solve(j_x, symmetric, data) {
+        return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_q, k_w)? });
+    }
+    Ok(())
+}
+
+/// [`end_compliance`] with `K_W` given by its generators (the arm's dense path): `K_W` is
+/// written straight into the storage of `K_q + K_W` (its LU's), which one pass then completes
+/// while forming the lower triangle of the symmetric part for the Cholesky factorisation. The
+/// same sums as [`end_compliance`] with the dense `K_W`, term for term; no dof × dof matrix
+/// besides those two. Returns `Ok(false)` when the symmetric part is not positive definite
+/// (the caller reports the smallest eigenvalue).
+///
+/// # Errors
+/// [`StiffnessError::NonFinite`]; [`StiffnessError::DimensionMismatch`].
+pub(crate) fn end_compliance_generated(
+    k_q: &ColMajor,
+    k_w: &KwGenerators,
+    j_x: MatRef<'_, f64>,
+    data: &mut EndStiffnessData,
+) -> Result<bool, StiffnessError> {
+    let n = data.dof;
+    check_square("K_q", k_q.as_ref(), n)?;
+    if j_x.nrows() != 6 || j_x.ncols() != n {
+        let got = if j_x.nrows() != 6 { j_x.nrows() } else { j_x.ncols() };
+        let expected = if j_x.nrows() != 6 { 6 } else { n };
+        return Err(StiffnessError::DimensionMismatch { what: "J_x", expected, got });
+    }
+    k_w.fill_dense(data.a.as_mut()).map_err(|_| StiffnessError::DimensionMismatch {
+        what: "K_W",
+        expected: n,
+        got: k_w.len(),
+    })?;
+    // K_q + K_W in place, column by column.
+    for j in 0..n {
+        for (a, k) in data.a.col_mut(j).iter_mut().zip(k_q.col(j)) {
+            *a += k; // k + a: IEEE addition commutes exactly
+        }
+    }
+    // Finiteness, exact symmetry, the lower triangle of the symmetric part.
+    let mut symmetric = true;
+    for j in 0..n {
+        for i in j..n {
+            let (l, u) = (data.a.at(i, j), data.a.at(j, i));
+            if !(l.is_finite() && u.is_finite()) {
+                return Err(StiffnessError::NonFinite { what: "K_q + K_W" });
+            }
+            symmetric &= u == l;
+            *data.sym.at_mut(i, j) = 0.5 * (u + l);
+        }
+    }
+    Ok(factor_and_solve(j_x, symmetric, data))
+}
+
+/// The Cholesky factorisation of `data.sym` (lower triangle: the symmetric part of
+/// `K_q + K_W`), which is the stability verdict; then `X = (K_q + K_W)⁻¹ J_xᵀ` with that factor
+/// when `symmetric`, else with the LU of `data.a` (`K_q + K_W`), and `C_x = J_x X`. `false`
+/// when the factorisation fails (not positive definite).
+fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffnessData) -> bool {
+    let n = data.dof;
     let stack = MemStack::new(&mut data.buffer);
     let stable = llt::factor::cholesky_in_place(
         data.sym.as_mut(),
@@ -257,7 +319,7 @@ pub fn end_compliance(
     )
     .is_ok();
     if !stable {
-        return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_q, k_w)? });
+        return false;
     }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
     for c in 0..6 {
@@ -308,7 +370,7 @@ pub fn end_compliance(
             }
         }
     }
-    Ok(())
+    true
 }
 
 /// `C_x` and then `K_x = C_x⁻¹` (eq. 19) into `data`; read them with

@@ -79,6 +79,7 @@ pub(crate) fn joint_stiffness_in_blocks(
     geometry: &RoutingData,
     tensions: &[f64],
     layout: &BlockLayout,
+    (plan, scratch): (&InherentPlan, &mut InherentScratch),
     controllable: &mut ColMajor,
     inherent: &mut ColMajor,
     k_q: &mut ColMajor,
@@ -96,9 +97,14 @@ pub(crate) fn joint_stiffness_in_blocks(
     }
     if !layout.structured() {
         zero_blocks(layout, controllable);
-        geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
+        add_weighted_hessians(
+            routing,
+            geometry.segment_hessians(routing)?,
+            tensions,
+            controllable,
+        )?;
         zero_blocks(layout, inherent);
-        add_inherent_upper(routing, geometry, inherent.as_mut())?;
+        plan.add_upper(geometry.jacobian()?, scratch, inherent)?;
         mirror_upper(inherent.as_mut(), layout.blocks());
         for block in layout.blocks() {
             for j in block.clone() {
@@ -231,6 +237,173 @@ fn add_inherent_upper(
         }
     }
     Ok(())
+}
+
+/// `out += Σ_c f_c H_c` segment by segment, each block column by column: the sums of
+/// [`RoutingData::add_weighted_hessians`] in the same order, written through column slices.
+fn add_weighted_hessians(
+    routing: &Routing,
+    hessians: SegmentHessians<'_>,
+    tensions: &[f64],
+    out: &mut ColMajor,
+) -> Result<(), StiffnessError> {
+    for (s, (seg, h)) in hessians.iter().enumerate() {
+        let (lo, n) = (seg.dofs.start, seg.dofs.len());
+        if n == 0 {
+            continue;
+        }
+        let Some(&w) = tensions.get(seg.cable) else {
+            return Err(StiffnessError::DimensionMismatch {
+                what: "tensions",
+                expected: routing.cable_count(),
+                got: tensions.len(),
+            });
+        };
+        if h.len() != n * n || lo + n > out.rows() || lo + n > out.cols() {
+            return Err(StiffnessError::DimensionMismatch {
+                what: "segment Hessian",
+                expected: n * n,
+                got: s,
+            });
+        }
+        if let [h00, h10, h01, h11] = *h {
+            // A segment across one universal joint (every routed segment): fixed bounds.
+            let col = &mut out.col_mut(lo)[lo..lo + 2];
+            col[0] += w * h00;
+            col[1] += w * h10;
+            let col = &mut out.col_mut(lo + 1)[lo..lo + 2];
+            col[0] += w * h01;
+            col[1] += w * h11;
+            continue;
+        }
+        for (k, h) in h.chunks_exact(n).enumerate() {
+            let col = &mut out.col_mut(lo + k)[lo..lo + n];
+            for (v, h) in col.iter_mut().zip(h) {
+                *v += w * h;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Width of the row blocks of [`InherentPlan::add_upper`]: eight `f64` accumulators, two AVX
+/// registers.
+const LANES: usize = 8;
+
+/// What [`InherentPlan::add_upper`] needs of the routing, computed once per model: for each
+/// column `j` of `J_cᵀ K_l J_c`, the cables whose rows of `J_c` can be non-zero there and the
+/// first row they reach; and every cable's `k_c`.
+///
+/// Routed, cable `c` spans its joint and every joint before it, so the cables crossing DOF `j`
+/// are those of joint `⌊j/2⌋` on (a contiguous range: cables are ordered by joint) and they all
+/// start at DOF 0: `J_c` is a staircase.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct InherentPlan {
+    dof: usize,
+    /// Row stride of [`InherentScratch::rows`]: `dof` rounded up to [`LANES`].
+    stride: usize,
+    /// Column `j`: the first row `i` with a non-zero term, and the range of cables (routing
+    /// order) bounding those whose DOFs contain `j` (cables inside that do not contribute
+    /// exact zeros).
+    columns: Vec<(usize, Range<usize>)>,
+    stiffness: Vec<f64>,
+}
+
+/// The workspace of [`InherentPlan::add_upper`]: `J_c` row by row (cable `c` at
+/// `rows[c · stride ..]`, zero-padded), and one column of `K_l J_c`.
+#[derive(Debug, Clone)]
+pub(crate) struct InherentScratch {
+    rows: Vec<f64>,
+    weights: Vec<f64>,
+}
+
+impl InherentPlan {
+    pub(crate) fn new(routing: &Routing) -> InherentPlan {
+        let dof = routing.dof();
+        let stride = dof.div_ceil(LANES) * LANES;
+        let columns = (0..dof)
+            .map(|j| {
+                let mut first_row = j;
+                let (mut lo, mut hi) = (usize::MAX, 0);
+                for (c, cable) in routing.cables().iter().enumerate() {
+                    if cable.dofs.contains(&j) {
+                        first_row = first_row.min(cable.dofs.start);
+                        lo = lo.min(c);
+                        hi = c + 1;
+                    }
+                }
+                (first_row, if lo < hi { lo..hi } else { 0..0 })
+            })
+            .collect();
+        let stiffness = routing.cables().iter().map(|c| c.stiffness).collect();
+        InherentPlan { dof, stride, columns, stiffness }
+    }
+
+    pub(crate) fn scratch(&self) -> InherentScratch {
+        InherentScratch {
+            rows: vec![0.0; self.stiffness.len() * self.stride],
+            weights: vec![0.0; self.stiffness.len()],
+        }
+    }
+
+    /// `out += J_cᵀ K_l J_c` on and above the diagonal (the caller mirrors it), column `j` over
+    /// the cables crossing DOF `j` only, rows in blocks of [`LANES`] accumulated in registers
+    /// over the cables: entry `(i, j)` is `Σ_c (k_c J_c[c, j]) · J_c[c, i]` summed in routing
+    /// order from zero, the same sum as [`add_inherent_upper`] (the extra terms are exact
+    /// zeros). `O(Σ_j |cables crossing j| · j)`, no allocation.
+    fn add_upper(
+        &self,
+        j_c: MatRef<'_, f64>,
+        scratch: &mut InherentScratch,
+        out: &mut ColMajor,
+    ) -> Result<(), StiffnessError> {
+        let (m, n, stride) = (self.stiffness.len(), self.dof, self.stride);
+        let sizes = [
+            ("inherent stiffness", n, out.cols()),
+            ("cable Jacobian", m, j_c.nrows()),
+            ("cable Jacobian", n, j_c.ncols()),
+            ("inherent scratch", m * stride, scratch.rows.len()),
+            ("inherent scratch", m, scratch.weights.len()),
+        ];
+        for (what, expected, got) in sizes {
+            if expected != got {
+                return Err(StiffnessError::DimensionMismatch { what, expected, got });
+            }
+        }
+        let InherentScratch { rows, weights } = scratch;
+        for (c, row) in rows.chunks_exact_mut(stride).enumerate() {
+            for (i, v) in row[..n].iter_mut().enumerate() {
+                *v = j_c[(c, i)];
+            }
+        }
+        for (j, (first_row, cables)) in self.columns.iter().enumerate() {
+            let rows = &rows[cables.start * stride..cables.end * stride];
+            let (weights, stiffness) =
+                (&mut weights[cables.clone()], &self.stiffness[cables.clone()]);
+            for ((w, k), row) in weights.iter_mut().zip(stiffness).zip(rows.chunks_exact(stride)) {
+                *w = k * row[j];
+            }
+            let col = &mut out.col_mut(j)[..=j];
+            let mut block = first_row - first_row % LANES;
+            while block <= j {
+                let mut acc = [0.0; LANES];
+                for (&w, row) in weights.iter().zip(rows.chunks_exact(stride)) {
+                    let r = &row[block..block + LANES];
+                    for t in 0..LANES {
+                        acc[t] += w * r[t];
+                    }
+                }
+                for t in 0..LANES {
+                    let i = block + t;
+                    if i >= *first_row && i <= j {
+                        col[i] += acc[t];
+                    }
+                }
+                block += LANES;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Copy the strict upper triangle of each diagonal block `blocks` of `out` to its lower one.

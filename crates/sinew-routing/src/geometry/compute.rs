@@ -134,31 +134,92 @@ pub fn compute_cable_geometry_from_kinematics(
         let inv_length = 1.0 / length;
         let u = scale(&d, inv_length);
         let (lo, n) = (seg.dofs.start, seg.dofs.len());
-        for k in 0..n {
-            // v_k = a_k × (o_p_B − p_k) = ∂d/∂q_k,  g_k = u · v_k = ∂L/∂q_k.
-            let v_k = cross(&axes[lo + k], &sub(&o_p_b, &origins[lo + k]));
-            let g_k = dot(&u, &v_k);
-            v[k] = v_k;
-            g[k] = g_k;
-            jacobian[seg.cable + (lo + k) * m] += g_k;
-        }
-        if order < Order::Hessians {
-            continue;
-        }
-        let block = &mut hessians[seg.hessian_offset..seg.hessian_offset + n * n];
-        for k in 0..n {
-            // d · (a_i × v_k) = a_i · (v_k × d) for i ≤ k.
-            let t = cross(&v[k], &d);
-            let (v_k, g_k) = (v[k], g[k]);
-            for i in 0..=k {
-                let h = (dot(&v[i], &v_k) - g[i] * g_k + dot(&axes[lo + i], &t)) * inv_length;
-                block[i + k * n] = h;
-                block[k + i * n] = h;
-            }
+        let (Some(a), Some(p)) = (axes.get(lo..lo + n), origins.get(lo..lo + n)) else {
+            return Err(mismatch(dof));
+        };
+        let Some(column) = jacobian.get_mut(seg.cable + lo * m..) else {
+            return Err(mismatch(dof));
+        };
+        let hessian = if order < Order::Hessians {
+            None
+        } else {
+            hessians.get_mut(seg.hessian_offset..seg.hessian_offset + n * n)
+        };
+        let parts = (&o_p_b, &d, &u, inv_length, a, p, m);
+        // A segment across one universal joint (the common case) with fixed sizes.
+        match n {
+            1 => segment_derivatives::<1>(parts, column, hessian),
+            2 => segment_derivatives::<2>(parts, column, hessian),
+            _ => segment_derivatives_any(parts, (&mut v[..], &mut g[..]), column, hessian),
         }
     }
     data.computed = Some(order);
     Ok(())
+}
+
+/// What a segment's derivatives need: `o_p_B`, `d`, `u`, `1/L`, the axes and origins of its
+/// joints, and the number of cables (the column stride of `J_c`).
+type SegmentParts<'a> =
+    (&'a [f64; 3], &'a [f64; 3], &'a [f64; 3], f64, &'a [[f64; 3]], &'a [[f64; 3]], usize);
+
+/// A segment's row of `J_c` (added into `column`, which starts at its cable's entry of its
+/// first joint) and its Hessian block (written when asked for), over `N` joints: the loops
+/// of [`segment_derivatives_any`] with fixed bounds, the same operations in the same order.
+#[inline(always)]
+fn segment_derivatives<const N: usize>(
+    (o_p_b, d, u, inv_length, axes, origins, m): SegmentParts<'_>,
+    column: &mut [f64],
+    hessian: Option<&mut [f64]>,
+) {
+    let mut v = [[0.0; 3]; N];
+    let mut g = [0.0; N];
+    for k in 0..N {
+        let v_k = cross(&axes[k], &sub(o_p_b, &origins[k]));
+        let g_k = dot(u, &v_k);
+        v[k] = v_k;
+        g[k] = g_k;
+        column[k * m] += g_k;
+    }
+    let Some(block) = hessian else { return };
+    let block = &mut block[..N * N];
+    for k in 0..N {
+        let t = cross(&v[k], d);
+        let (v_k, g_k) = (v[k], g[k]);
+        for i in 0..=k {
+            let h = (dot(&v[i], &v_k) - g[i] * g_k + dot(&axes[i], &t)) * inv_length;
+            block[i + k * N] = h;
+            block[k + i * N] = h;
+        }
+    }
+}
+
+/// [`segment_derivatives`] for any number of joints, with the workspace's scratch.
+fn segment_derivatives_any(
+    (o_p_b, d, u, inv_length, axes, origins, m): SegmentParts<'_>,
+    (v, g): (&mut [[f64; 3]], &mut [f64]),
+    column: &mut [f64],
+    hessian: Option<&mut [f64]>,
+) {
+    let n = axes.len();
+    for k in 0..n {
+        // v_k = a_k × (o_p_B − p_k) = ∂d/∂q_k,  g_k = u · v_k = ∂L/∂q_k.
+        let v_k = cross(&axes[k], &sub(o_p_b, &origins[k]));
+        let g_k = dot(u, &v_k);
+        v[k] = v_k;
+        g[k] = g_k;
+        column[k * m] += g_k;
+    }
+    let Some(block) = hessian else { return };
+    for k in 0..n {
+        // d · (a_i × v_k) = a_i · (v_k × d) for i ≤ k.
+        let t = cross(&v[k], d);
+        let (v_k, g_k) = (v[k], g[k]);
+        for i in 0..=k {
+            let h = (dot(&v[i], &v_k) - g[i] * g_k + dot(&axes[i], &t)) * inv_length;
+            block[i + k * n] = h;
+            block[k + i * n] = h;
+        }
+    }
 }
 
 fn mismatch(dof: usize) -> RoutingError {

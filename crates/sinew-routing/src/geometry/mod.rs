@@ -30,7 +30,7 @@ mod compute;
 use faer::{MatMut, MatRef};
 
 use crate::error::{Result, RoutingError};
-use crate::routing::{Routing, check_shape};
+use crate::routing::{Routing, Segment, check_shape};
 
 pub use compute::{compute_cable_geometry, compute_cable_geometry_from_kinematics};
 
@@ -257,6 +257,17 @@ impl<'a> SegmentHessians<'a> {
     #[inline]
     pub fn get(&self, s: usize) -> Option<MatRef<'a, f64>> {
         hessian_block(self.routing, self.hessians, s)
+    }
+
+    /// Every segment with its Hessian block (column-major, `|dofs|²` entries, empty for a
+    /// segment whose length depends on no joint), in the order of [`Routing::segments`]: for
+    /// loops over all segments, without the per-segment lookups of [`SegmentHessians::get`].
+    pub fn iter(&self) -> impl Iterator<Item = (&'a Segment, &'a [f64])> + 'a {
+        let hessians = self.hessians;
+        self.routing.segments.iter().map(move |seg| {
+            let n = seg.dofs.len();
+            (seg, hessians.get(seg.hessian_offset..seg.hessian_offset + n * n).unwrap_or(&[]))
+        })
     }
 }
 
