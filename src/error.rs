@@ -119,8 +119,10 @@ fn routing_kind(e: &RoutingError) -> ErrorKind {
 fn statics_kind(e: &StaticsError) -> ErrorKind {
     match e {
         // Whatever the reason: a rank-deficient joint block, lost force closure, or limits.
-        StaticsError::Infeasible { .. } => ErrorKind::Infeasible,
+        StaticsError::Infeasible { .. } | StaticsError::NoEquilibrium(_) => ErrorKind::Infeasible,
         StaticsError::NonFiniteTorque { .. }
+        | StaticsError::LevelsUnavailable(_)
+        | StaticsError::NotBalanced { .. }
         | StaticsError::NoSuchJoint { .. }
         | StaticsError::InvalidLevel { .. }
         | StaticsError::UnsupportedRouting { .. }
@@ -128,6 +130,7 @@ fn statics_kind(e: &StaticsError) -> ErrorKind {
         | StaticsError::NonFiniteWrench { .. } => ErrorKind::Input,
         StaticsError::Robot(e) => robot_kind(e),
         StaticsError::Routing(e) => routing_kind(e),
+        // NonFiniteInput, Numerical, Solver and any later numerical variant.
         _ => ErrorKind::Numerical,
     }
 }

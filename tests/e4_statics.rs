@@ -17,7 +17,7 @@ fn solve_at_e4(
     f0: &Vector6<f64>,
 ) -> (ArmStaticsData, Result<(), StaticsError>) {
     let (robot, routing) = cdhrm5::robot_and_routing(model);
-    let statics = ArmStatics::new(&routing).unwrap();
+    let statics = ArmStatics::new(&routing);
     let mut rdata = RobotData::new(&robot);
     let mut gdata = RoutingData::new(&routing);
     let mut data = statics.data(&robot);

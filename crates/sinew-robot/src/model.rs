@@ -1,5 +1,7 @@
 //! The immutable robot description: a serial chain of revolute joints built once from a URDF.
 
+use std::ops::Range;
+
 use nalgebra::{IsometryMatrix3, Matrix3, Point3, Unit, Vector3};
 
 use crate::error::{Result, RobotError};
@@ -73,6 +75,37 @@ pub struct Robot {
     pub(crate) tip: LinkPlacement,
     /// `subtree_mass[j]`: total mass of the bodies moved by joint `j` (bodies `j + 1 ..`).
     pub(crate) subtree_mass: Vec<f64>,
+    /// [`Robot::joint_groups`].
+    pub(crate) joint_groups: Vec<Range<usize>>,
+    /// `dof_joint[d]`: the arm joint that revolute joint `d` belongs to.
+    pub(crate) dof_joint: Vec<usize>,
+}
+
+/// A joint origin closer than this to its parent body's frame origin, m, counts as coincident
+/// when grouping revolute joints ([`Robot::joint_groups`]).
+pub const COINCIDENT_ORIGIN: f64 = 1e-12;
+
+/// The arm's joints as groups of revolute joints (see [`Robot::joint_groups`]): revolute joint
+/// `k` and `k + 1` form one universal joint when the body between them is massless, joint
+/// `k + 1` sits at that body's origin (its origin has no translation) and their axes are not
+/// parallel; any other revolute joint is a 1-DOF joint of its own. Greedy from the base.
+pub(crate) fn group_joints(joints: &[Joint], bodies: &[Body]) -> Vec<Range<usize>> {
+    let mut groups = Vec::new();
+    let mut k = 0;
+    while k < joints.len() {
+        let pairs = k + 1 < joints.len() && {
+            let next = &joints[k + 1];
+            let between = &bodies[k + 1];
+            let second_axis = next.origin.rotation * next.axis.into_inner();
+            between.mass <= 0.0
+                && next.origin.translation.vector.norm() <= COINCIDENT_ORIGIN
+                && joints[k].axis.cross(&second_axis).norm() > 1e-9
+        };
+        let len = if pairs { 2 } else { 1 };
+        groups.push(k..k + len);
+        k += len;
+    }
+    groups
 }
 
 /// The part of a robot description that URDF does not carry.
@@ -98,6 +131,31 @@ impl Robot {
     /// Number of revolute joints, the length of `Q`.
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// The arm's joints, base first, each as the range of its revolute joints in `Q`: `k..k + 2`
+    /// for a universal joint (two consecutive revolute joints with intersecting axes and a
+    /// massless cross between them, as a URDF writes a universal joint), `k..k + 1` for a lone
+    /// revolute joint. Tension levels, cable ownership and the per-joint outputs are counted
+    /// in these joints. The paper's arms are all universal (`2n` DOF, joint `i` owning
+    /// `q[2i]`, `q[2i + 1]`).
+    pub fn joint_groups(&self) -> &[Range<usize>] {
+        &self.joint_groups
+    }
+
+    /// The number of arm joints ([`Robot::joint_groups`]).
+    pub fn joint_count(&self) -> usize {
+        self.joint_groups.len()
+    }
+
+    /// The arm joint revolute joint `dof` belongs to, `None` past the last one.
+    pub fn joint_of_dof(&self, dof: usize) -> Option<usize> {
+        self.dof_joint.get(dof).copied()
+    }
+
+    /// Whether every arm joint is a 2-DOF universal joint (the paper's arms).
+    pub fn is_universal(&self) -> bool {
+        self.joint_groups.iter().all(|g| g.len() == 2)
     }
 
     /// The revolute joints from base to tip.

@@ -314,6 +314,11 @@ impl Builder<'_> {
             subtree_mass[j] = acc;
         }
 
+        let joint_groups = crate::model::group_joints(&joints, &bodies);
+        let mut dof_joint = vec![0; joints.len()];
+        for (g, group) in joint_groups.iter().enumerate() {
+            dof_joint[group.clone()].fill(g);
+        }
         let name = urdf.name.clone();
         let tip = links.iter().find(|p| p.name == settings.tip_link).cloned().ok_or_else(|| {
             RobotError::NoSuchLink { robot: name.clone(), link: settings.tip_link.clone() }
@@ -327,6 +332,8 @@ impl Builder<'_> {
             gravity: settings.gravity,
             tip,
             subtree_mass,
+            joint_groups,
+            dof_joint,
         })
     }
 }

@@ -39,9 +39,10 @@ pub enum RoutingError {
         /// What is wrong.
         message: &'static str,
     },
-    /// The robot does not consist of universal joints (an even number of revolute joints).
+    /// The `[pattern]` form on a robot whose joints are not all universal
+    /// ([`sinew_robot::Robot::joint_groups`]).
     #[error(
-        "{file}: robot `{robot}` has {dof} revolute joints; a routing needs pairs (universal joints)"
+        "{file}: robot `{robot}` ({dof} revolute joints) has joints that are not universal; the [pattern] form needs universal joints: give the cables as [[cable]] entries"
     )]
     NotUniversal {
         /// The routing file.
@@ -283,42 +284,45 @@ pub enum JointProblem {
         joints: usize,
     },
     /// The anchor (last hole) is not on a body that the driven joint moves and no further
-    /// joint does (bodies `2·joint + 1` and `2·joint + 2`).
+    /// joint does (bodies `first..=last`; `2·joint + 1`, `2·joint + 2` on a universal arm).
     AnchorElsewhere {
         /// The joint driven (0-based).
         joint: usize,
         /// The anchor's body.
         anchor_body: usize,
+        /// The first body the joint moves and no further joint does.
+        first: usize,
+        /// The last such body.
+        last: usize,
     },
     /// The anchor is on the base body: the cable drives no joint.
     AnchorOnBase,
-    /// No hole lies proximal to the driven joint (on a body ≤ `2·joint`).
+    /// No hole lies proximal to the driven joint (on a body ≤ `proximal`, the body before
+    /// the joint's first revolute joint: `2·joint` on a universal arm).
     NotCrossing {
         /// The joint driven (0-based).
         joint: usize,
+        /// The last body proximal to the joint.
+        proximal: usize,
     },
 }
 
 impl std::fmt::Display for JointProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match *self {
-            JointProblem::NoSuchJoint { joint, joints } => write!(
+            JointProblem::NoSuchJoint { joint, joints } => {
+                write!(f, "joint {joint} does not exist: the robot has joints 0..{joints}")
+            }
+            JointProblem::AnchorElsewhere { joint, anchor_body, first, last } => write!(
                 f,
-                "joint {joint} does not exist: the robot has universal joints 0..{joints}"
-            ),
-            JointProblem::AnchorElsewhere { joint, anchor_body } => write!(
-                f,
-                "the anchor is on body {anchor_body}, but a cable driving joint {joint} must end on body {} or {} (moved by joint {joint} and no further joint)",
-                2 * joint + 1,
-                2 * joint + 2
+                "the anchor is on body {anchor_body}, but a cable driving joint {joint} must end on a body in {first}..={last} (moved by joint {joint} and no further joint)"
             ),
             JointProblem::AnchorOnBase => {
                 f.write_str("the anchor is on the base body: the cable drives no joint")
             }
-            JointProblem::NotCrossing { joint } => write!(
+            JointProblem::NotCrossing { joint, proximal } => write!(
                 f,
-                "no hole lies proximal to joint {joint} (on a body ≤ {}): the cable does not cross the joint it drives",
-                2 * joint
+                "no hole lies proximal to joint {joint} (on a body ≤ {proximal}): the cable does not cross the joint it drives"
             ),
         }
     }

@@ -34,9 +34,10 @@
 //! ```toml
 //! [[cable]]
 //! name = "a"
-//! joint = 0                              # optional: the universal joint it drives (0-based);
-//!                                        # default (anchor body − 1) / 2
+//! joint = 0                              # optional: the joint it drives (0-based); default the
+//!                                        # joint that moves its anchor (and no further joint does)
 //! free_length = 3.1                      # optional: overrides the top-level value
+//! tension_limits = [10.0, 400.0]         # optional: overrides the top-level limits, N
 //! holes = [
 //!   { link = "base_link", point = [0.022, 0.0, 0.0] },
 //!   { link = "link1", point = [0.022, 0.0, 0.0] },
@@ -144,12 +145,17 @@ pub struct HoleSpec {
 pub struct ExplicitCable {
     /// Unique name.
     pub name: String,
-    /// The universal joint it drives (0-based); default `(anchor body − 1) / 2`.
+    /// The joint it drives (0-based, [`sinew_robot::Robot::joint_groups`]); default the joint
+    /// whose revolute joints move its anchor and no further joint's do (`(anchor body − 1) / 2`
+    /// on a universal arm).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint: Option<usize>,
     /// Free length from the actuator, m; default the file's `free_length` for its joint.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub free_length: Option<f64>,
+    /// `[f_min, f_max]` of this cable, N; default the file's `tension_limits`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tension_limits: Option<[f64; 2]>,
     /// The holes from the base to the anchor (the last one).
     pub holes: Vec<HoleSpec>,
 }

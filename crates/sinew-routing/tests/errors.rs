@@ -253,7 +253,10 @@ fn wrong_joint() {
     assert!(
         matches!(
             err,
-            RoutingError::WrongJoint { problem: JointProblem::NotCrossing { joint: 0 }, .. }
+            RoutingError::WrongJoint {
+                problem: JointProblem::NotCrossing { joint: 0, proximal: 0 },
+                ..
+            }
         ),
         "{err:?}"
     );
@@ -324,16 +327,25 @@ fn bad_numbers_in_cables() {
 }
 
 #[test]
-fn odd_revolute_count() {
+fn pattern_needs_universal_joints() {
+    // One revolute joint: a 1-DOF joint, which explicit cables can drive but the three-cable
+    // pattern cannot.
     let urdf = r#"<robot name="one"><link name="base"/><link name="tip"/>
       <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
       <axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
     let settings =
         ChainSettings { tip_link: "tip".to_owned(), gravity: nalgebra::Vector3::zeros() };
     let robot = Robot::from_urdf_str(urdf, "one.urdf", &settings).unwrap();
-    let err = Routing::from_toml_str(&explicit(GOOD_CABLE), FILE, &robot).unwrap_err();
+    assert_eq!(robot.joint_groups(), &[0..1]);
+    let text = pattern(r#"["base"]"#, r#"["tip"]"#);
+    let err = Routing::from_toml_str(&text, FILE, &robot).unwrap_err();
     assert!(matches!(err, RoutingError::NotUniversal { dof: 1, .. }), "{err:?}");
     assert!(err.to_string().contains(FILE));
+    assert!(err.to_string().contains("[[cable]]"), "{err}");
+    let cables = "[[cable]]\nname = \"a\"\nholes = [{ link = \"base\", point = [0.0, 0.02, 0.0] }, { link = \"tip\", point = [0.0, 0.02, 0.1] }]\n";
+    let routing = Routing::from_toml_str(&explicit(cables), FILE, &robot).unwrap();
+    assert_eq!(routing.cable_joints(), &[0]);
+    assert_eq!(routing.cable_joint_span(0), Some(0..1));
 }
 
 /// Load `text`; when it loads, evaluate it at Q = 0 and at a bent configuration. Nothing may

@@ -1,20 +1,42 @@
-//! The arm's statics in one call: `T0`, every joint's tension interval, the tensions at given
-//! levels (eq. 6, 22–23), for a robot and its routing.
+//! The arm's statics in one call: `T0`, then the tensions, for a robot and its routing (eq. 6,
+//! 22–23): at the paper's tension levels in closed form (three cables per universal joint), by
+//! a named policy over the equilibrium set of any cable set, or given and checked.
+
+use std::ops::Range;
 
 use nalgebra::{Matrix3x2, Vector2, Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
 
 use crate::distribution::{CableLayout, distribute_tensions};
-use crate::error::{InfeasibleReason, StaticsError};
+use crate::equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, norm};
+use crate::error::{InfeasibleReason, StaticsError, UnsupportedRouting};
 use crate::interval::{TensionInterval, TensionLimits, minimum_norm_tensions};
 use crate::joint_end::{JointEndData, equilibrium_torques};
+use crate::policy::{Distribution, TensionPolicy, distribute_with_policy};
+
+/// How to choose the tensions among those that balance the load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TensionChoice<'a> {
+    /// The paper's tension levels, one per joint in `[0, 1]` (0: least total tension, 1: most;
+    /// spec §4), in closed form. Needs three cables per universal joint with common limits
+    /// ([`ArmStatics::closed_form`]).
+    Levels(&'a [f64]),
+    /// A named policy over the equilibrium set (any cable set).
+    Policy(TensionPolicy),
+    /// These tensions (m, N, routing order), checked: within their limits and balancing the
+    /// load to [`EQUILIBRIUM_TOLERANCE`].
+    Given(&'a [f64]),
+}
 
 /// What the statics of an arm needs from its routing, checked once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArmStatics {
-    layout: CableLayout,
+    closed_form: Result<CableLayout, UnsupportedRouting>,
     limits: TensionLimits,
+    cable_limits: Vec<[f64; 2]>,
+    cable_names: Vec<String>,
+    groups: Vec<Range<usize>>,
 }
 
 /// Workspace and results of [`ArmStatics::solve`], sized once.
@@ -23,10 +45,14 @@ pub struct ArmStaticsData {
     joint_end: JointEndData,
     /// `T0 = T_g + J_xᵀ F0` (2n, N m).
     pub t0: Vec<f64>,
-    /// Every joint's feasible tension interval (n).
+    /// Every joint's feasible tension interval (n) after a solve at levels (closed form); empty
+    /// for a routing the closed form does not take.
     pub intervals: Vec<TensionInterval>,
-    /// The tensions at the requested levels (3n, N), cables in routing order.
+    /// The tensions (m, N), cables in routing order.
     pub tensions: Vec<f64>,
+    /// The policy's answer of the last solve by a policy (`None` after levels or given
+    /// tensions).
+    pub distribution: Option<Distribution>,
 }
 
 impl ArmStaticsData {
@@ -38,31 +64,60 @@ impl ArmStaticsData {
 }
 
 impl ArmStatics {
-    /// Check the routing against the solver (see [`CableLayout::new`]).
+    /// The statics of `routing`: any cable set; the closed form of the tension levels when the
+    /// routing fits it (see [`CableLayout::new`]).
+    pub fn new(routing: &Routing) -> ArmStatics {
+        let [f_min, f_max] = routing.tension_limits();
+        ArmStatics {
+            closed_form: CableLayout::new(routing),
+            limits: TensionLimits { f_min, f_max },
+            cable_limits: routing.cable_limits().to_vec(),
+            cable_names: routing.cables().iter().map(|c| c.name.clone()).collect(),
+            groups: routing.joint_groups().to_vec(),
+        }
+    }
+
+    /// The cable layout of the closed form (three cables per universal joint, common limits).
     ///
     /// # Errors
-    /// [`StaticsError::UnsupportedRouting`].
-    pub fn new(routing: &Routing) -> Result<ArmStatics, StaticsError> {
-        let [f_min, f_max] = routing.tension_limits();
-        Ok(ArmStatics {
-            layout: CableLayout::new(routing)?,
-            limits: TensionLimits { f_min, f_max },
-        })
+    /// [`StaticsError::LevelsUnavailable`] saying why the routing does not fit it.
+    pub fn closed_form(&self) -> Result<&CableLayout, StaticsError> {
+        self.closed_form.as_ref().map_err(|why| StaticsError::LevelsUnavailable(why.clone()))
     }
 
-    /// The cable layout.
-    pub fn layout(&self) -> &CableLayout {
-        &self.layout
+    /// Whether the tension levels apply (the closed form takes the routing).
+    pub fn has_levels(&self) -> bool {
+        self.closed_form.is_ok()
     }
 
-    /// The tension limits of every cable.
+    /// The number of joints.
+    pub fn joints(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// The number of cables.
+    pub fn cable_count(&self) -> usize {
+        self.cable_limits.len()
+    }
+
+    /// The common tension limits (the routing file's).
     pub fn limits(&self) -> TensionLimits {
         self.limits
     }
 
+    /// `[f_min, f_max]` of every cable, N.
+    pub fn cable_limits(&self) -> &[[f64; 2]] {
+        &self.cable_limits
+    }
+
+    /// The joints as DOF ranges.
+    pub fn joint_groups(&self) -> &[Range<usize>] {
+        &self.groups
+    }
+
     /// A workspace for this arm.
     pub fn data(&self, robot: &Robot) -> ArmStaticsData {
-        let n = self.layout.joints();
+        let n = self.closed_form.as_ref().map_or(0, CableLayout::joints);
         let empty = TensionInterval {
             joint: 0,
             particular: Vector3::zeros(),
@@ -74,9 +129,10 @@ impl ArmStatics {
         };
         ArmStaticsData {
             joint_end: JointEndData::new(robot),
-            t0: vec![0.0; 2 * n],
+            t0: vec![0.0; robot.dof()],
             intervals: (0..n).map(|joint| TensionInterval { joint, ..empty }).collect(),
-            tensions: vec![0.0; 3 * n],
+            tensions: vec![0.0; self.cable_count()],
+            distribution: None,
         }
     }
 
@@ -85,8 +141,8 @@ impl ArmStatics {
     /// `compute_cable_geometry` with at least [`Order::Jacobian`]). No allocation.
     ///
     /// # Errors
-    /// [`StaticsError::Infeasible`] naming the first joint that fails, and the errors of the
-    /// steps above.
+    /// [`StaticsError::Infeasible`] naming the first joint that fails,
+    /// [`StaticsError::LevelsUnavailable`], and the errors of the steps above.
     pub fn solve(
         &self,
         robot: &Robot,
@@ -96,16 +152,116 @@ impl ArmStatics {
         f0: &Vector6<f64>,
         levels: &[f64],
     ) -> Result<(), StaticsError> {
+        self.solve_with(robot, rdata, routing_data, data, f0, TensionChoice::Levels(levels))
+    }
+
+    /// `T0` and the tensions chosen by `choice`, from kinematics and a cable Jacobian already
+    /// computed for the same `Q`. Levels: no allocation. A policy: the equilibrium set and a
+    /// small convex program (they allocate).
+    ///
+    /// # Errors
+    /// Levels: as [`ArmStatics::solve`]. A policy: [`StaticsError::NoEquilibrium`] naming the
+    /// joints and the joint motion along which the cables fall short. Given tensions:
+    /// [`StaticsError::NotBalanced`]. And the errors of the steps above.
+    pub fn solve_with(
+        &self,
+        robot: &Robot,
+        rdata: &mut RobotData,
+        routing_data: &RoutingData,
+        data: &mut ArmStaticsData,
+        f0: &Vector6<f64>,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StaticsError> {
         equilibrium_torques(robot, rdata, &mut data.joint_end, f0, &mut data.t0)?;
-        distribute_tensions(
-            &self.layout,
-            routing_data.jacobian()?,
-            self.limits,
-            &data.t0,
-            levels,
-            &mut data.intervals,
-            &mut data.tensions,
-        )
+        data.distribution = None;
+        match choice {
+            TensionChoice::Levels(levels) => distribute_tensions(
+                self.closed_form()?,
+                routing_data.jacobian()?,
+                self.limits,
+                &data.t0,
+                levels,
+                &mut data.intervals,
+                &mut data.tensions,
+            ),
+            TensionChoice::Policy(policy) => {
+                let set = self.equilibrium_set(routing_data, data)?;
+                let answer = distribute_with_policy(
+                    &set,
+                    policy,
+                    &self.groups,
+                    &self.cable_names,
+                    &mut data.tensions,
+                )?;
+                data.distribution = Some(answer);
+                Ok(())
+            }
+            TensionChoice::Given(tensions) => {
+                self.check_balance(routing_data, &data.t0, tensions)?;
+                data.tensions.copy_from_slice(tensions);
+                Ok(())
+            }
+        }
+    }
+
+    /// The equilibrium set `f = f_p + N λ` at the last solved `Q` and load (its `T0` in
+    /// `data`), with every cable's limits.
+    ///
+    /// # Errors
+    /// As [`EquilibriumSet::new`].
+    pub fn equilibrium_set(
+        &self,
+        routing_data: &RoutingData,
+        data: &ArmStaticsData,
+    ) -> Result<EquilibriumSet, StaticsError> {
+        EquilibriumSet::new(routing_data.jacobian()?, &data.t0, &self.cable_limits, &self.groups)
+    }
+
+    /// Check that `tensions` are within their limits and balance `t0`.
+    fn check_balance(
+        &self,
+        routing_data: &RoutingData,
+        t0: &[f64],
+        tensions: &[f64],
+    ) -> Result<(), StaticsError> {
+        let m = self.cable_count();
+        if tensions.len() != m {
+            return Err(StaticsError::DimensionMismatch {
+                what: "tensions",
+                expected: m,
+                got: tensions.len(),
+            });
+        }
+        for (c, (&f, [lo, hi])) in tensions.iter().zip(&self.cable_limits).enumerate() {
+            if !(f.is_finite() && *lo <= f && f <= *hi) {
+                let problem = format!(
+                    "leave the limits: cable `{}` has {} N, outside [{}, {}] N",
+                    self.cable_names[c],
+                    sinew_robot::Compact(f),
+                    sinew_robot::Compact(*lo),
+                    sinew_robot::Compact(*hi)
+                );
+                return Err(StaticsError::NotBalanced { problem });
+            }
+        }
+        let jacobian = routing_data.jacobian()?;
+        let residual: Vec<f64> = (0..t0.len())
+            .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * tensions[c]).sum::<f64>())
+            .collect();
+        let scale = norm(t0).max(
+            (0..t0.len())
+                .map(|d| (0..m).map(|c| (jacobian[(c, d)] * tensions[c]).abs()).sum::<f64>())
+                .fold(0.0, f64::max),
+        );
+        if norm(&residual) > EQUILIBRIUM_TOLERANCE * scale {
+            let problem = format!(
+                "do not balance the load: |T0 + J_cᵀ f| = {} N m, |T0| = {} N m",
+                sinew_robot::Compact(norm(&residual)),
+                sinew_robot::Compact(norm(t0))
+            );
+            return Err(StaticsError::NotBalanced { problem });
+        }
+        Ok(())
     }
 
     /// `∂f/∂λ_i`: how every tension changes per unit of joint `i`'s null-space coordinate,
@@ -116,8 +272,9 @@ impl ArmStatics {
     /// the same `Q` first. No allocation.
     ///
     /// # Errors
-    /// [`StaticsError::NoSuchJoint`], [`StaticsError::DimensionMismatch`];
-    /// [`StaticsError::Infeasible`] for a rank-deficient proximal joint.
+    /// [`StaticsError::LevelsUnavailable`], [`StaticsError::NoSuchJoint`],
+    /// [`StaticsError::DimensionMismatch`]; [`StaticsError::Infeasible`] for a rank-deficient
+    /// proximal joint.
     pub fn tension_sensitivity(
         &self,
         routing_data: &RoutingData,
@@ -125,7 +282,8 @@ impl ArmStatics {
         joint: usize,
         out: &mut [f64],
     ) -> Result<(), StaticsError> {
-        let n = self.layout.joints();
+        let layout = self.closed_form()?;
+        let n = layout.joints();
         if joint >= n {
             return Err(StaticsError::NoSuchJoint { joint, joints: n });
         }
@@ -138,7 +296,7 @@ impl ArmStatics {
         }
         out.fill(0.0);
         out[3 * joint..3 * joint + 3].copy_from_slice(data.intervals[joint].null.as_slice());
-        if !self.layout.crossing() {
+        if !layout.crossing() {
             return Ok(());
         }
         let jacobian = routing_data.jacobian()?;

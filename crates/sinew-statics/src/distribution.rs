@@ -34,12 +34,23 @@ impl CableLayout {
     /// crosses proximal joints (the routed model: not [`Routing::is_decoupled`]).
     ///
     /// # Errors
-    /// [`StaticsError::UnsupportedRouting`] saying what does not fit.
-    pub fn new(routing: &Routing) -> Result<CableLayout, StaticsError> {
-        let unsupported = |why| Err(StaticsError::UnsupportedRouting(why));
+    /// [`UnsupportedRouting`] saying what does not fit.
+    pub fn new(routing: &Routing) -> Result<CableLayout, UnsupportedRouting> {
+        let unsupported = Err;
         let dof = routing.dof();
         if !dof.is_multiple_of(2) {
             return unsupported(UnsupportedRouting::OddDof { dof });
+        }
+        if let Some((joint, g)) =
+            routing.joint_groups().iter().enumerate().find(|(_, g)| g.len() != 2)
+        {
+            return unsupported(UnsupportedRouting::NotUniversal { joint, dofs: g.len() });
+        }
+        if !routing.has_uniform_limits() {
+            let limits = routing.tension_limits();
+            let c = routing.cable_limits().iter().position(|l| *l != limits).unwrap_or(0);
+            let cable = routing.cables().get(c).map(|c| c.name.clone()).unwrap_or_default();
+            return unsupported(UnsupportedRouting::CableLimits { cable });
         }
         let joints = dof / 2;
         let cables = routing.cables();

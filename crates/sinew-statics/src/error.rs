@@ -8,12 +8,23 @@ use sinew_robot::Compact;
 pub enum InfeasibleReason {
     /// The joint's cable Jacobian block has rank < 2: the cables cannot produce some torque.
     RankDeficient,
-    /// The null space of `J_cᵀ` has no strictly positive direction: the cables cannot all be
-    /// tensioned together without unbalancing the joint (lost force closure). `null` is the
-    /// unit null direction found.
+    /// The null space of `J_cᵀ` has no strictly positive direction (lost force closure) and
+    /// that alone decides nothing: kept for callers that require force closure. The solvers of
+    /// this crate report force closure as a property instead
+    /// ([`crate::TensionInterval::force_closure`]) and answer whenever tensions within the
+    /// limits exist.
     NoForceClosure {
         /// Unit null direction of `J_cᵀ`.
         null: [f64; 3],
+    },
+    /// Cable `cable` (0, 1 or 2 of the joint) cannot change its tension without unbalancing
+    /// the joint (its null-direction component is zero), and the tension it must keep is
+    /// outside the limits.
+    FixedTension {
+        /// The cable, 0-based within the joint.
+        cable: usize,
+        /// The tension it must keep, N.
+        tension: f64,
     },
     /// Every balancing tension vector leaves some cable outside `[f_min, f_max]`: the limits
     /// would need `λ ≥ lambda_min` and `λ ≤ lambda_max` with `lambda_min > lambda_max`.
@@ -35,6 +46,12 @@ impl std::fmt::Display for InfeasibleReason {
                 Compact(null[0]),
                 Compact(null[1]),
                 Compact(null[2])
+            ),
+            InfeasibleReason::FixedTension { cable, tension } => write!(
+                f,
+                "its cable {} must keep the tension {} N, outside the limits, whatever the others do",
+                cable + 1,
+                Compact(*tension)
             ),
             InfeasibleReason::OutsideLimits { lambda_min, lambda_max } => write!(
                 f,
@@ -77,6 +94,18 @@ pub enum UnsupportedRouting {
         /// The joint it drives (0-based).
         joint: usize,
     },
+    /// A joint that is not a 2-DOF universal joint.
+    NotUniversal {
+        /// The joint (0-based).
+        joint: usize,
+        /// Its number of revolute joints.
+        dofs: usize,
+    },
+    /// A cable with limits of its own.
+    CableLimits {
+        /// The cable.
+        cable: String,
+    },
     /// A cable whose length changes with a joint beyond the one it drives.
     BeyondOwnJoint {
         /// The cable.
@@ -106,6 +135,12 @@ impl std::fmt::Display for UnsupportedRouting {
                 "cable `{cable}` drives joint {}; expected 3 cables per joint, in joint order",
                 joint + 1
             ),
+            UnsupportedRouting::NotUniversal { joint, dofs } => {
+                write!(f, "joint {} has {dofs} revolute joint(s), not 2", joint + 1)
+            }
+            UnsupportedRouting::CableLimits { cable } => {
+                write!(f, "cable `{cable}` has tension limits of its own")
+            }
             UnsupportedRouting::BeyondOwnJoint { cable, joint } => write!(
                 f,
                 "cable `{cable}` of joint {} changes length with joints beyond its own",
@@ -175,10 +210,123 @@ pub enum StaticsError {
         /// The wrench.
         wrench: [f64; 6],
     },
+    /// No tensions within the limits balance the load (any cable set): the typed outcome of
+    /// an infeasible load on the general path, with the joint motion along which the cables
+    /// fall short.
+    #[error("{0}")]
+    NoEquilibrium(Box<NoEquilibrium>),
+    /// Tension levels asked of a routing the closed form does not take.
+    #[error(
+        "tension levels need three cables per universal joint with common limits ({0}); choose a tension policy instead (least-total, least-norm, safest)"
+    )]
+    LevelsUnavailable(UnsupportedRouting),
+    /// Given tensions that do not balance the load or leave their limits.
+    #[error("the given tensions {problem}")]
+    NotBalanced {
+        /// What is wrong, with the numbers.
+        problem: String,
+    },
+    /// A NaN or infinite entry in a computed input (the cable Jacobian, `T0`).
+    #[error("{what} has a NaN or infinite entry")]
+    NonFiniteInput {
+        /// What.
+        what: &'static str,
+    },
+    /// A factorisation failed to converge.
+    #[error("{what} did not converge")]
+    Numerical {
+        /// Which.
+        what: &'static str,
+    },
+    /// The convex solver (clarabel) stopped without an answer or a certificate.
+    #[error("the tension solver stopped without an answer: {status}")]
+    Solver {
+        /// The solver's status.
+        status: String,
+    },
     /// An error of the robot model (sizes, workspace).
     #[error(transparent)]
     Robot(#[from] sinew_robot::RobotError),
     /// An error of the cable geometry.
     #[error(transparent)]
     Routing(#[from] sinew_routing::RoutingError),
+}
+
+/// Why no tensions within the limits balance the load (any cable set,
+/// [`StaticsError::NoEquilibrium`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoEquilibrium {
+    /// The joints concerned (0-based): those that move along the certificate's joint motion.
+    pub joints: Vec<usize>,
+    /// The reason, with its numbers.
+    pub cause: NoEquilibriumCause,
+}
+
+/// The two ways a load can have no balancing tensions.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum NoEquilibriumCause {
+    /// `T0` has a component no tensions produce: along the joint motion `direction` (unit,
+    /// dof) the cables exert no torque, and the load needs `torque` (N m).
+    Unreachable {
+        /// The joint motion the cables cannot resist.
+        direction: Vec<f64>,
+        /// The torque the load needs along it, N m.
+        torque: f64,
+    },
+    /// The cables could balance the load, but not within their limits. Along the joint motion
+    /// `direction` (largest component 1) every balancing tension vector gives the same torque
+    /// `needed` (N m), while tensions within the limits give only `range` (N m): the
+    /// solver's certificate of infeasibility. Reaching `needed` would take the cables
+    /// `at_max` beyond `f_max` or the cables `at_min` below `f_min`.
+    Limits {
+        /// The joint motion (largest component 1).
+        direction: Vec<f64>,
+        /// The torque the load needs along it, N m.
+        needed: f64,
+        /// `[least, greatest]` torque along it with tensions within the limits, N m.
+        range: [f64; 2],
+        /// The cables that pull as hard as they may along it.
+        at_max: Vec<String>,
+        /// The cables that are as slack as they may be along it.
+        at_min: Vec<String>,
+    },
+}
+
+impl std::fmt::Display for NoEquilibrium {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let joints: Vec<String> = self.joints.iter().map(|j| (j + 1).to_string()).collect();
+        let joints = match joints.len() {
+            0 => String::from("the arm"),
+            1 => format!("joint {}", joints[0]),
+            _ => format!("joints {}", joints.join(", ")),
+        };
+        let vector =
+            |v: &[f64]| v.iter().map(|x| Compact(*x).to_string()).collect::<Vec<_>>().join(", ");
+        match &self.cause {
+            NoEquilibriumCause::Unreachable { direction, torque } => write!(
+                f,
+                "no cable tensions balance the load at {joints}: the cables exert no torque along the joint motion [{}], where the load needs {} N m",
+                vector(direction),
+                Compact(*torque)
+            ),
+            NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } => {
+                write!(
+                    f,
+                    "no tensions within the limits balance the load at {joints}: along the joint motion [{}] the load needs {} N m from the cables, who give only [{}, {}] N m within their limits",
+                    vector(direction),
+                    Compact(*needed),
+                    Compact(range[0]),
+                    Compact(range[1])
+                )?;
+                if !at_max.is_empty() {
+                    write!(f, "; {} at f_max", at_max.join(", "))?;
+                }
+                if !at_min.is_empty() {
+                    write!(f, "; {} at f_min", at_min.join(", "))?;
+                }
+                write!(f, " (raise those limits or lighten the load)")
+            }
+        }
+    }
 }

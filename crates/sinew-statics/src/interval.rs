@@ -10,17 +10,24 @@
 //! n   = J_c[:,0] × J_c[:,1] / |…|    (spans null(J_cᵀ), oriented so that n > 0)
 //! ```
 //!
-//! The cables are in force closure when `n` can be chosen strictly positive; then
-//! `Ω ∩ P` (eq. 22) is the interval `λ ∈ [max_k (f_min − f_p,k)/n_k, min_k (f_max − f_p,k)/n_k]`,
-//! and every tension rises with `λ`, so `λ_min` is the end of least total tension (level
-//! `s = 0`) and `λ_max` that of most (`s = 1`).
+//! `n` is oriented so that its components sum to `≥ 0`: the total tension then rises with `λ`,
+//! and `λ_min` is the end of least total tension (level `s = 0`), `λ_max` that of most
+//! (`s = 1`). `Ω ∩ P` (eq. 22) is the interval of `λ` where every cable is within its limits:
+//! cable `k` bounds `λ` from below by `(f_min − f_p,k)/n_k` when `n_k > 0` (by
+//! `(f_max − f_p,k)/n_k` when `n_k < 0`) and from above by the other limit.
+//!
+//! The cables are in *force closure* when `n` is strictly positive: every tension rises with
+//! `λ`, so any torque is held with tensions high enough. Force closure is a property of the
+//! pose and the routing, reported ([`TensionInterval::force_closure`]), not required: without
+//! it the interval may still be non-empty (a cable with `n_k < 0` slackens as the others
+//! tighten), and a cable with `n_k = 0` keeps the tension `f_p,k` whatever `λ`.
 
 use nalgebra::{Matrix3x2, Vector2, Vector3};
 
 use crate::error::{InfeasibleReason, StaticsError};
 
-/// A component of the null direction below this fraction of its norm counts as zero: the
-/// cables have lost force closure (one tension cannot be changed without losing balance).
+/// A component of the (unit) null direction below this in magnitude counts as zero: that cable's
+/// tension cannot be changed without losing balance, and the joint is not in force closure.
 pub const FORCE_CLOSURE_TOLERANCE: f64 = 1e-9;
 
 /// `det(J_cᵀ J_c)` below this fraction of `(trace)²` counts as a rank-deficient cable Jacobian.
@@ -42,7 +49,8 @@ pub struct TensionInterval {
     pub joint: usize,
     /// The minimum-norm tensions that hold the torque, `f_p` (N; may lie outside the limits).
     pub particular: Vector3<f64>,
-    /// Unit null direction of `J_cᵀ`, every component positive.
+    /// Unit null direction of `J_cᵀ`, its components summing to `≥ 0` (every component
+    /// positive when the joint is in force closure).
     pub null: Vector3<f64>,
     /// Lower end of the interval (least total tension).
     pub lambda_min: f64,
@@ -50,8 +58,10 @@ pub struct TensionInterval {
     pub lambda_max: f64,
     /// The tension limits the interval was clipped to.
     pub limits: TensionLimits,
-    /// The cable (0, 1 or 2) at `f_min` at `λ_min`, and the one at `f_max` at `λ_max`: at the
-    /// ends they are set exactly on their limit ([`TensionInterval::tensions`]).
+    /// The cable (0, 1 or 2) on a limit at `λ_min`, and the one on a limit at `λ_max`: at the
+    /// ends they are set exactly on it ([`TensionInterval::tensions`]). In force closure these
+    /// are `f_min` at `λ_min` and `f_max` at `λ_max`; a cable with `n_k < 0` meets the other
+    /// limit.
     pub limiting: [usize; 2],
 }
 
@@ -67,13 +77,21 @@ impl TensionInterval {
                 *v = v.clamp(f_min, f_max);
             }
             if lambda == self.lambda_min {
-                f[self.limiting[0].min(2)] = f_min;
+                let k = self.limiting[0].min(2);
+                f[k] = if self.null[k] > 0.0 { f_min } else { f_max };
             }
             if lambda == self.lambda_max {
-                f[self.limiting[1].min(2)] = f_max;
+                let k = self.limiting[1].min(2);
+                f[k] = if self.null[k] > 0.0 { f_max } else { f_min };
             }
         }
         f
+    }
+
+    /// Whether the joint's cables are in force closure: the null direction strictly positive
+    /// (above [`FORCE_CLOSURE_TOLERANCE`]), so every tension rises with `λ`.
+    pub fn force_closure(&self) -> bool {
+        self.null.min() > FORCE_CLOSURE_TOLERANCE
     }
 
     /// `λ` at tension level `s ∈ [0, 1]` (0: least total tension, 1: most; both ends exactly).
@@ -129,8 +147,9 @@ pub fn minimum_norm_tensions(
 /// `tau` the torque its cables must hold (`τ = −J_cᵀ f`). `O(1)`, no allocation.
 ///
 /// # Errors
-/// [`StaticsError::Infeasible`] naming the joint and the reason: a rank-deficient `J_c`, lost
-/// force closure, or a torque that no tensions within the limits hold.
+/// [`StaticsError::Infeasible`] naming the joint and the reason: a rank-deficient `J_c`, a
+/// cable whose tension is fixed outside its limits, or a torque that no tensions within the
+/// limits hold. Lost force closure alone is not an error ([`TensionInterval::force_closure`]).
 pub fn tension_interval(
     joint: usize,
     jacobian: &Matrix3x2<f64>,
@@ -156,15 +175,23 @@ pub fn tension_interval(
     if null.sum() < 0.0 {
         null = -null;
     }
-    if null.min() <= FORCE_CLOSURE_TOLERANCE {
-        return Err(infeasible(InfeasibleReason::NoForceClosure { null: null.into() }));
-    }
     let mut lambda_min = f64::NEG_INFINITY;
     let mut lambda_max = f64::INFINITY;
     let mut limiting = [0, 0];
     for k in 0..3 {
-        let lo = (limits.f_min - particular[k]) / null[k];
-        let hi = (limits.f_max - particular[k]) / null[k];
+        if null[k].abs() <= FORCE_CLOSURE_TOLERANCE {
+            // The tension of cable k is f_p,k whatever λ: it must be within the limits.
+            if !(limits.f_min..=limits.f_max).contains(&particular[k]) {
+                let tension = particular[k];
+                return Err(infeasible(InfeasibleReason::FixedTension { cable: k, tension }));
+            }
+            continue;
+        }
+        let (lo, hi) = if null[k] > 0.0 {
+            ((limits.f_min - particular[k]) / null[k], (limits.f_max - particular[k]) / null[k])
+        } else {
+            ((limits.f_max - particular[k]) / null[k], (limits.f_min - particular[k]) / null[k])
+        };
         if lo > lambda_min {
             (lambda_min, limiting[0]) = (lo, k);
         }

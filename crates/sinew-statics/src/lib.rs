@@ -8,21 +8,31 @@
 //! - joint-end statics (eq. 6–9): `T0 = T_g + J_xᵀ F0` ([`equilibrium_torques`]), and in the
 //!   same pass `J_x` and `K_W = ∂T0/∂Q` as its `O(dof)` generators ([`KwGenerators`], the one
 //!   owner of `∂T0/∂Q`; dense: [`equilibrium_torque_derivative`]);
-//! - all of it for a robot and its routing in one call ([`ArmStatics`]).
+//! - for any cable set (any number of cables, shared cables, 1-DOF and 2-DOF joints): the
+//!   equilibrium set `f = f_p + N λ` and its polytope ([`EquilibriumSet`]), and the named
+//!   tension policies over it ([`TensionPolicy`]: least total tension, least 2-norm, farthest
+//!   from the limits), solved with clarabel;
+//! - all of it for a robot and its routing in one call ([`ArmStatics`], [`TensionChoice`]).
 //!
-//! Infeasible loads and lost force closure are typed outcomes ([`StaticsError::Infeasible`]
-//! with an [`InfeasibleReason`]) naming the joint — never a NaN, never a panic.
+//! Infeasible loads are typed outcomes naming the joint — [`StaticsError::Infeasible`] with an
+//! [`InfeasibleReason`] in closed form, [`StaticsError::NoEquilibrium`] on the general path —
+//! never a NaN, never a panic. Force closure is reported, not required.
 #![deny(missing_docs)]
 
 mod arm;
 mod distribution;
+mod equilibrium;
 mod error;
 mod interval;
 mod joint_end;
+mod policy;
 
-pub use arm::{ArmStatics, ArmStaticsData};
+pub use arm::{ArmStatics, ArmStaticsData, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
-pub use error::{InfeasibleReason, StaticsError, UnsupportedRouting};
+pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, SET_RANK_TOLERANCE};
+pub use error::{
+    InfeasibleReason, NoEquilibrium, NoEquilibriumCause, StaticsError, UnsupportedRouting,
+};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,
     tension_interval,
@@ -30,6 +40,7 @@ pub use interval::{
 pub use joint_end::{
     JointEndData, KwGenerators, equilibrium_torque_derivative, equilibrium_torques,
 };
+pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
 
 use faer::MatRef;
 

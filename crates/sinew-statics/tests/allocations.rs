@@ -19,7 +19,7 @@ fn solving_the_statics_allocates_nothing() {
     for model in cdhrm5::MODELS {
         let routing = cdhrm5::routing(&robot, model);
         let file = cdhrm5::routing_file(model);
-        let statics = ArmStatics::new(&routing).unwrap();
+        let statics = ArmStatics::new(&routing);
         let mut rdata = RobotData::new(&robot);
         let mut gdata = RoutingData::new(&routing);
         let mut data = statics.data(&robot);

@@ -12,7 +12,7 @@
 use nalgebra::Vector6;
 use sinew_robot::Robot;
 use sinew_routing::{Order, Routing, compute_cable_geometry};
-use sinew_statics::ArmStatics;
+use sinew_statics::{ArmStatics, TensionChoice};
 
 use crate::data::ArmStiffnessData;
 use crate::end::{end_compliance_generated, stability_margin};
@@ -54,11 +54,12 @@ impl ArmStiffness {
     ///
     /// # Errors
     /// [`StiffnessError::Routing`] with [`sinew_routing::RoutingError::RobotMismatch`];
-    /// [`StiffnessError::Statics`] with [`sinew_statics::StaticsError::UnsupportedRouting`].
+    /// (Any cable set is accepted: the tension levels need the closed form,
+    /// [`sinew_statics::ArmStatics::closed_form`]; the policies do not.)
     pub fn new(robot: &Robot, routing: &Routing) -> Result<ArmStiffness, StiffnessError> {
         routing.check_robot(robot)?;
         Ok(ArmStiffness {
-            statics: ArmStatics::new(routing)?,
+            statics: ArmStatics::new(routing),
             layout: BlockLayout::new(routing),
             inherent: InherentPlan::new(routing),
             robot: robot.clone(),
@@ -135,6 +136,22 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         levels: &[f64],
     ) -> Result<(), StiffnessError> {
+        self.joint_level_with(data, q, f0, TensionChoice::Levels(levels))
+    }
+
+    /// [`ArmStiffness::joint_level`] with the tensions chosen by `choice`: the paper's levels,
+    /// a named policy over the equilibrium set (any cable set), or given tensions.
+    ///
+    /// # Errors
+    /// As [`ArmStiffness::joint_level`], and those of
+    /// [`sinew_statics::ArmStatics::solve_with`].
+    pub fn joint_level_with(
+        &self,
+        data: &mut ArmStiffnessData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StiffnessError> {
         self.check(data)?;
         data.solver = EndSolver::NotYet;
         data.structured.backward_error = f64::NAN;
@@ -146,13 +163,13 @@ impl ArmStiffness {
             q,
             Order::Hessians,
         )?;
-        self.statics.solve(
+        self.statics.solve_with(
             &self.robot,
             &mut data.robot,
             &data.cables,
             &mut data.statics,
             f0,
-            levels,
+            choice,
         )?;
         joint_stiffness_in_blocks(
             &self.routing,
@@ -226,7 +243,23 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         levels: &[f64],
     ) -> Result<(), StiffnessError> {
-        self.joint_level(data, q, f0, levels)?;
+        self.evaluate_with(data, q, f0, TensionChoice::Levels(levels))
+    }
+
+    /// [`ArmStiffness::evaluate`] with the tensions chosen by `choice` (levels, a policy over
+    /// the equilibrium set of any cable set, or given tensions). With levels, no allocation on
+    /// success; a policy solves a small convex program, which allocates.
+    ///
+    /// # Errors
+    /// As [`ArmStiffness::evaluate`], and those of [`sinew_statics::ArmStatics::solve_with`].
+    pub fn evaluate_with(
+        &self,
+        data: &mut ArmStiffnessData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StiffnessError> {
+        self.joint_level_with(data, q, f0, choice)?;
         self.compliance(data)?;
         data.end.invert_compliance()
     }
@@ -243,7 +276,22 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         levels: &[f64],
     ) -> Result<(), StiffnessError> {
-        self.joint_level(data, q, f0, levels)?;
+        self.evaluate_compliance_with(data, q, f0, TensionChoice::Levels(levels))
+    }
+
+    /// [`ArmStiffness::evaluate_compliance`] with the tensions chosen by `choice`.
+    ///
+    /// # Errors
+    /// As [`ArmStiffness::evaluate_compliance`], and those of
+    /// [`sinew_statics::ArmStatics::solve_with`].
+    pub fn evaluate_compliance_with(
+        &self,
+        data: &mut ArmStiffnessData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StiffnessError> {
+        self.joint_level_with(data, q, f0, choice)?;
         self.compliance(data)
     }
 

@@ -363,6 +363,7 @@ impl RandomChain {
                     name: format!("x{}c{}", i + 1, k + 1),
                     joint: None,
                     free_length: None,
+                    tension_limits: None,
                     holes,
                 });
             }

@@ -9,7 +9,8 @@ use nalgebra::Vector3;
 use sinew_robot::{BodyPoint, Robot, RobotData};
 
 use super::expand::{
-    check_cable, check_material, check_per_joint, expand_explicit, expand_pattern,
+    CheckedCable, check_cable, check_material, check_per_joint, expand_explicit, expand_pattern,
+    valid_limits,
 };
 use super::{Cable, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment};
 use crate::error::{Result, RoutingError};
@@ -28,13 +29,10 @@ impl Routing {
     pub fn new(robot: &Robot, spec: &RoutingSpec, source_name: &str) -> Result<Routing> {
         let file = source_name.to_owned();
         let dof = robot.dof();
-        if !dof.is_multiple_of(2) {
-            return Err(RoutingError::NotUniversal { file, robot: robot.name().to_owned(), dof });
-        }
-        let n = dof / 2;
+        let n = robot.joint_count();
         let area = check_material(&file, spec)?;
         let [f_min, f_max] = spec.tension_limits;
-        if !(f_min.is_finite() && f_max.is_finite() && f_min >= 0.0 && f_min < f_max) {
+        if !valid_limits(f_min, f_max) {
             return Err(RoutingError::InvalidTensionLimits { file, f_min, f_max });
         }
         if let Some(free) = &spec.free_length {
@@ -55,6 +53,10 @@ impl Routing {
                 });
             }
             (Some(pattern), true) => {
+                if !robot.is_universal() {
+                    let robot = robot.name().to_owned();
+                    return Err(RoutingError::NotUniversal { file, robot, dof });
+                }
                 let model = match pattern.model {
                     PatternModel::Decoupled => RoutingModel::Decoupled,
                     PatternModel::Routed => RoutingModel::Routed,
@@ -75,10 +77,10 @@ impl Routing {
                     field: cable.field.clone(),
                 });
             }
-            let (joint, free_length, holes) = check_cable(&file, robot, spec, &cable, n)?;
-            checked.push((cable, joint, free_length, holes));
+            let c = check_cable(&file, robot, spec, &cable)?;
+            checked.push((cable, c));
         }
-        checked.sort_by_key(|c| c.1);
+        checked.sort_by_key(|c| c.1.joint);
 
         // Evaluate at Q = 0: segment lengths, elastic lengths, stiffness.
         let mut rdata = RobotData::new(robot);
@@ -87,7 +89,8 @@ impl Routing {
         let mut segments = Vec::new();
         let mut hessian_len = 0;
         let mut max_span = 0;
-        for (c, (r, joint, free_length, holes)) in checked.into_iter().enumerate() {
+        for (c, (r, checked)) in checked.into_iter().enumerate() {
+            let CheckedCable { joint, free_length, limits, holes } = checked;
             let first_segment = segments.len();
             let mut routed_length = 0.0;
             let (mut lo, mut hi) = (usize::MAX, 0);
@@ -140,6 +143,7 @@ impl Routing {
             out_cables.push(Cable {
                 name: r.name.clone(),
                 joint,
+                tension_limits: limits,
                 holes,
                 free_length,
                 routed_length,
@@ -151,8 +155,12 @@ impl Routing {
         }
 
         let dof_blocks = dof_blocks(dof, &out_cables);
-        let decoupled =
-            out_cables.iter().all(|c| c.dofs.start >= 2 * c.joint && c.dofs.end <= 2 * c.joint + 2);
+        let groups = robot.joint_groups();
+        let decoupled = out_cables.iter().all(|c| {
+            let own = &groups[c.joint];
+            c.dofs.start >= own.start && c.dofs.end <= own.end
+        });
+        let cable_limits: Vec<[f64; 2]> = out_cables.iter().map(|c| c.tension_limits).collect();
         Ok(Routing {
             dof_blocks,
             decoupled,
@@ -163,6 +171,9 @@ impl Routing {
             youngs_modulus: spec.material.youngs_modulus,
             area,
             tension_limits: spec.tension_limits,
+            uniform_limits: cable_limits.iter().all(|l| *l == spec.tension_limits),
+            cable_limits,
+            joint_groups: groups.to_vec(),
             cable_joint: out_cables.iter().map(|c| c.joint).collect(),
             stiffness: out_cables.iter().map(|c| c.stiffness).collect(),
             cables: out_cables,

@@ -16,6 +16,8 @@ pub(super) struct RawCable {
     pub(super) joint: Option<usize>,
     /// An explicit free length, with its field.
     pub(super) free_length: Option<(f64, String)>,
+    /// Explicit tension limits, with their field.
+    pub(super) tension_limits: Option<([f64; 2], String)>,
     /// Link, point in the link frame, field naming the link.
     pub(super) holes: Vec<(String, [f64; 3], String)>,
 }
@@ -172,6 +174,7 @@ pub(super) fn expand_pattern(
                 field: "pattern".to_owned(),
                 joint: Some(i),
                 free_length: None,
+                tension_limits: None,
                 holes,
             });
         }
@@ -188,6 +191,7 @@ pub(super) fn expand_explicit(cables: &[crate::spec::ExplicitCable]) -> Vec<RawC
             field: format!("cable[{c}]"),
             joint: cable.joint,
             free_length: cable.free_length.map(|v| (v, format!("cable[{c}].free_length"))),
+            tension_limits: cable.tension_limits.map(|v| (v, format!("cable[{c}].tension_limits"))),
             holes: cable
                 .holes
                 .iter()
@@ -200,14 +204,13 @@ pub(super) fn expand_explicit(cables: &[crate::spec::ExplicitCable]) -> Vec<RawC
         .collect()
 }
 
-/// Check one cable against the robot: (joint, free length, holes).
+/// Check one cable against the robot: its joint, free length, limits and holes.
 pub(super) fn check_cable(
     file: &str,
     robot: &Robot,
     spec: &RoutingSpec,
     cable: &RawCable,
-    n: usize,
-) -> Result<(usize, f64, Vec<Hole>)> {
+) -> Result<CheckedCable> {
     let name = &cable.name;
     if cable.holes.len() < 2 {
         return Err(RoutingError::TooFewHoles {
@@ -249,26 +252,29 @@ pub(super) fn check_cable(
         field,
         problem,
     };
+    let groups = robot.joint_groups();
+    let n = groups.len();
+    // The joint whose revolute joints move the anchor and no further joint's do.
+    let anchor_joint = anchor.checked_sub(1).and_then(|d| robot.joint_of_dof(d));
     let joint = match cable.joint {
         Some(j) => {
             let field = format!("{}.joint", cable.field);
             if j >= n {
                 return Err(wrong(field, JointProblem::NoSuchJoint { joint: j, joints: n }));
             }
-            if anchor == 0 || (anchor - 1) / 2 != j {
+            if anchor_joint != Some(j) {
+                let (first, last) = (groups[j].start + 1, groups[j].end);
                 return Err(wrong(
                     anchor_field,
-                    JointProblem::AnchorElsewhere { joint: j, anchor_body: anchor },
+                    JointProblem::AnchorElsewhere { joint: j, anchor_body: anchor, first, last },
                 ));
             }
             j
         }
-        None => {
-            if anchor == 0 {
-                return Err(wrong(anchor_field, JointProblem::AnchorOnBase));
-            }
-            (anchor - 1) / 2
-        }
+        None => match anchor_joint {
+            Some(j) => j,
+            None => return Err(wrong(anchor_field, JointProblem::AnchorOnBase)),
+        },
     };
     for (hole, raw) in holes.iter().zip(&cable.holes) {
         if hole.body_point.body > anchor {
@@ -283,8 +289,12 @@ pub(super) fn check_cable(
         }
     }
     let proximal = holes.iter().map(|h| h.body_point.body).min().unwrap_or(anchor);
-    if proximal > 2 * joint {
-        return Err(wrong(format!("{}.holes", cable.field), JointProblem::NotCrossing { joint }));
+    let joint_body = groups[joint].start;
+    if proximal > joint_body {
+        return Err(wrong(
+            format!("{}.holes", cable.field),
+            JointProblem::NotCrossing { joint, proximal: joint_body },
+        ));
     }
     let free_length = match &cable.free_length {
         Some((v, field)) => {
@@ -301,5 +311,39 @@ pub(super) fn check_cable(
         }
         None => spec.free_length.as_ref().and_then(|f| f.get(joint)).unwrap_or(0.0),
     };
-    Ok((joint, free_length, holes))
+    let limits = match &cable.tension_limits {
+        Some(([f_min, f_max], field)) => {
+            let (f_min, f_max) = (*f_min, *f_max);
+            if !valid_limits(f_min, f_max) {
+                let value = if f_min.is_finite() && f_min >= 0.0 { f_max } else { f_min };
+                return Err(RoutingError::InvalidValue {
+                    file: file.to_owned(),
+                    cable: name.clone(),
+                    field: field.clone(),
+                    value,
+                    expected: "[f_min, f_max] with 0 ≤ f_min < f_max, finite, N",
+                });
+            }
+            [f_min, f_max]
+        }
+        None => spec.tension_limits,
+    };
+    Ok(CheckedCable { joint, free_length, limits, holes })
+}
+
+/// A cable checked against the robot.
+pub(super) struct CheckedCable {
+    /// The joint it drives.
+    pub(super) joint: usize,
+    /// Its free length, m.
+    pub(super) free_length: f64,
+    /// Its tension limits, N.
+    pub(super) limits: [f64; 2],
+    /// Its holes.
+    pub(super) holes: Vec<Hole>,
+}
+
+/// Tension limits a cable can have: `0 ≤ f_min < f_max`, both finite.
+pub(super) fn valid_limits(f_min: f64, f_max: f64) -> bool {
+    f_min.is_finite() && f_max.is_finite() && f_min >= 0.0 && f_min < f_max
 }

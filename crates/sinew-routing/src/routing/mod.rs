@@ -67,8 +67,12 @@ pub struct Hole {
 pub struct Cable {
     /// Unique name (pattern cables: `j{i+1}c{k+1}`).
     pub name: String,
-    /// The universal joint it drives, 0-based (revolute joints `2·joint`, `2·joint + 1`).
+    /// The joint it drives, 0-based ([`Robot::joint_groups`]; on a universal arm revolute
+    /// joints `2·joint`, `2·joint + 1`): the joint that moves its anchor and no further joint
+    /// does.
     pub joint: usize,
+    /// `[f_min, f_max]`, N.
+    pub tension_limits: [f64; 2],
     /// Holes from the base to the anchor.
     pub holes: Vec<Hole>,
     /// Free length from the actuator, m.
@@ -127,6 +131,9 @@ pub struct Routing {
     pub(crate) youngs_modulus: f64,
     pub(crate) area: f64,
     pub(crate) tension_limits: [f64; 2],
+    pub(crate) cable_limits: Vec<[f64; 2]>,
+    pub(crate) uniform_limits: bool,
+    pub(crate) joint_groups: Vec<Range<usize>>,
     pub(crate) cables: Vec<Cable>,
     pub(crate) segments: Vec<Segment>,
     pub(crate) cable_joint: Vec<usize>,
@@ -177,9 +184,30 @@ impl Routing {
         self.area
     }
 
-    /// `[f_min, f_max]`, N, for every cable.
+    /// `[f_min, f_max]`, N: the file's limits, those of every cable that does not set its own
+    /// ([`Routing::cable_limits`]).
     pub fn tension_limits(&self) -> [f64; 2] {
         self.tension_limits
+    }
+
+    /// `[f_min, f_max]` of each cable, N (routing order).
+    pub fn cable_limits(&self) -> &[[f64; 2]] {
+        &self.cable_limits
+    }
+
+    /// Whether every cable has the file's limits [`Routing::tension_limits`].
+    pub fn has_uniform_limits(&self) -> bool {
+        self.uniform_limits
+    }
+
+    /// The robot's joints as ranges of its revolute joints ([`Robot::joint_groups`]).
+    pub fn joint_groups(&self) -> &[Range<usize>] {
+        &self.joint_groups
+    }
+
+    /// The number of joints of the robot ([`Robot::joint_count`]).
+    pub fn joint_count(&self) -> usize {
+        self.joint_groups.len()
     }
 
     /// The cables, ordered by joint.
@@ -192,7 +220,7 @@ impl Routing {
         &self.segments
     }
 
-    /// The universal joint each cable drives (`cable_joints()[c]`, 0-based, non-decreasing).
+    /// The joint each cable drives (`cable_joints()[c]`, 0-based, non-decreasing).
     pub fn cable_joints(&self) -> &[usize] {
         &self.cable_joint
     }
@@ -202,7 +230,7 @@ impl Routing {
         &self.stiffness
     }
 
-    /// The cables that drive universal joint `joint`: a range of [`Routing::cables`] (they are
+    /// The cables that drive joint `joint`: a range of [`Routing::cables`] (they are
     /// ordered by joint), empty for a joint no cable drives. `O(log m)`, no allocation.
     pub fn cables_of_joint(&self, joint: usize) -> Range<usize> {
         let lo = self.cable_joint.partition_point(|&j| j < joint);
@@ -210,17 +238,21 @@ impl Routing {
         lo..hi
     }
 
-    /// The universal joints whose DOFs cable `c`'s length depends on (the 2-DOF blocks of `J_c`
-    /// it spans): `J_c[c, d]` is exactly zero unless `d / 2` is in this range. `None` for no such
-    /// cable.
+    /// The joints whose DOFs cable `c`'s length depends on (the joint blocks of `J_c` it
+    /// spans): `J_c[c, d]` is exactly zero unless `d` belongs to a joint in this range. `None`
+    /// for no such cable.
     pub fn cable_joint_span(&self, c: usize) -> Option<Range<usize>> {
         let dofs = &self.cables.get(c)?.dofs;
-        Some(dofs.start / 2..dofs.end.div_ceil(2))
+        if dofs.is_empty() {
+            return Some(0..0);
+        }
+        let of = |d: usize| self.joint_groups.iter().position(|g| g.contains(&d));
+        Some(of(dofs.start)?..of(dofs.end - 1)? + 1)
     }
 
     /// Whether every cable changes length with the DOFs of the joint it drives only (the
-    /// decoupled model): `J_c` and the joint stiffness are then block diagonal, one 2 × 2 block
-    /// per universal joint at most.
+    /// decoupled model): `J_c` and the joint stiffness are then block diagonal, one block per
+    /// joint at most (2 × 2 for a universal joint).
     pub fn is_decoupled(&self) -> bool {
         self.decoupled
     }

@@ -1,0 +1,235 @@
+//! The equilibrium set of any cable set: every tension vector that balances the load, as
+//! `f = f_p + N λ`, and the polytope of `λ` that the tension limits leave (eq. 5, 22–23 for
+//! the whole arm, any number of cables, any routing).
+//!
+//! # Math
+//! The cables balance the joints when `−J_cᵀ f = T0` (eq. 5–6), `J_c` the m × dof cable
+//! Jacobian. With the singular value decomposition `J_c = U Σ Vᵀ` and `r` its numerical rank
+//! ([`SET_RANK_TOLERANCE`]):
+//!
+//! ```text
+//! f_p = −U_r Σ_r⁻¹ V_rᵀ T0        (the minimum-norm balancing tensions, f_p ⊥ N)
+//! N   = U[:, r..m]                (an orthonormal basis of null(J_cᵀ), m × (m − r))
+//! ```
+//!
+//! so every balancing tension vector is `f = f_p + N λ`, `λ ∈ R^(m−r)`, and `|f|² = |f_p|² +
+//! |λ|²`. The load is balanced at all only when `T0` lies in the span of the cable torques:
+//! the residual `T0 + J_cᵀ f_p` is zero (to [`EQUILIBRIUM_TOLERANCE`]); otherwise the motion
+//! `δq = V_⊥ V_⊥ᵀ T0` is one the cables cannot resist. The limits `f_min ≤ f ≤ f_max` then
+//! make `λ` range over the polytope `{λ : f_min − f_p ≤ N λ ≤ f_max − f_p}`; the load is
+//! feasible when it is not empty. With three cables per universal joint and no cable crossing
+//! another joint, `N` has one column per joint and the polytope is the box of the per-joint
+//! intervals of [`crate::tension_interval`].
+//!
+//! Force closure — some strictly positive `f` in `null(J_cᵀ)`, so that any torque can be held
+//! with high enough tensions — is a property of the pose and the routing
+//! ([`EquilibriumSet::force_closure`]), not a condition of feasibility.
+
+use std::ops::Range;
+
+use faer::{Mat, MatRef};
+
+use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
+
+/// A singular value of `J_c` below this fraction of the largest counts as zero.
+pub const SET_RANK_TOLERANCE: f64 = 1e-10;
+
+/// The relative equilibrium residual `|T0 + J_cᵀ f| / |T0|` accepted as balance.
+pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-9;
+
+/// The equilibrium set `f = f_p + N λ` of a cable set under a load, and its tension limits.
+///
+/// Built per configuration by [`EquilibriumSet::new`] (it allocates: an SVD of `J_c`); the
+/// tension policies of [`crate::TensionPolicy`] choose a point of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EquilibriumSet {
+    particular: Vec<f64>,
+    null: Mat<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    /// `U_r` (m × r), `Σ_r` (r), `V_r` (dof × r): `J_c⁺ = V_r Σ_r⁻¹ U_rᵀ` maps a cable vector
+    /// in the range of `J_c` back to joint space (for certificates).
+    u_range: Mat<f64>,
+    singular: Vec<f64>,
+    v_range: Mat<f64>,
+}
+
+impl EquilibriumSet {
+    /// The equilibrium set of the cable Jacobian `jacobian` (m × dof) under the equilibrium
+    /// torques `t0` (dof), with the limits `limits[c] = [f_min, f_max]` of every cable. `groups`
+    /// are the arm's joints as DOF ranges (to name them in errors).
+    ///
+    /// # Errors
+    /// [`StaticsError::DimensionMismatch`]; [`StaticsError::NonFiniteInput`] for a NaN in
+    /// `J_c` or `T0`; [`StaticsError::NoEquilibrium`] with
+    /// [`NoEquilibriumCause::Unreachable`] when `T0` has a component no tensions produce;
+    /// [`StaticsError::Numerical`] when the SVD fails.
+    pub fn new(
+        jacobian: MatRef<'_, f64>,
+        t0: &[f64],
+        limits: &[[f64; 2]],
+        groups: &[Range<usize>],
+    ) -> Result<EquilibriumSet, StaticsError> {
+        let (m, dof) = (jacobian.nrows(), jacobian.ncols());
+        for (what, expected, got) in
+            [("equilibrium torques T0", dof, t0.len()), ("tension limits", m, limits.len())]
+        {
+            if expected != got {
+                return Err(StaticsError::DimensionMismatch { what, expected, got });
+            }
+        }
+        let finite = t0.iter().all(|v| v.is_finite())
+            && (0..dof).all(|j| (0..m).all(|c| jacobian[(c, j)].is_finite()));
+        if !finite {
+            return Err(StaticsError::NonFiniteInput { what: "cable Jacobian or T0" });
+        }
+        let svd = jacobian.svd().map_err(|_| StaticsError::Numerical { what: "SVD of J_c" })?;
+        let s = svd.S().column_vector();
+        let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
+        let rank = (0..s.nrows()).filter(|&i| s[i] > SET_RANK_TOLERANCE * largest).count();
+        let u = svd.U();
+        let v = svd.V();
+        let u_range = u.subcols(0, rank).to_owned();
+        let v_range = v.subcols(0, rank).to_owned();
+        let singular: Vec<f64> = (0..rank).map(|i| s[i]).collect();
+        // f_p = −U_r Σ_r⁻¹ V_rᵀ T0.
+        let y: Vec<f64> = (0..rank)
+            .map(|i| (0..dof).map(|d| v_range[(d, i)] * t0[d]).sum::<f64>() / singular[i])
+            .collect();
+        let particular: Vec<f64> =
+            (0..m).map(|c| -(0..rank).map(|i| u_range[(c, i)] * y[i]).sum::<f64>()).collect();
+        let set = EquilibriumSet {
+            null: u.subcols(rank, m - rank).to_owned(),
+            lower: limits.iter().map(|l| l[0]).collect(),
+            upper: limits.iter().map(|l| l[1]).collect(),
+            particular,
+            u_range,
+            singular,
+            v_range,
+        };
+        // The residual T0 + J_cᵀ f_p: what the cables cannot produce.
+        let residual: Vec<f64> = (0..dof)
+            .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * set.particular[c]).sum::<f64>())
+            .collect();
+        let size = norm(&residual);
+        if size > EQUILIBRIUM_TOLERANCE * norm(t0) + f64::MIN_POSITIVE {
+            let direction: Vec<f64> = residual.iter().map(|r| r / size).collect();
+            return Err(StaticsError::NoEquilibrium(Box::new(NoEquilibrium {
+                joints: joints_along(&direction, groups),
+                cause: NoEquilibriumCause::Unreachable { direction, torque: size },
+            })));
+        }
+        Ok(set)
+    }
+
+    /// The number of cables `m`.
+    pub fn cable_count(&self) -> usize {
+        self.particular.len()
+    }
+
+    /// The dimension of the set, `m − rank(J_c)`: the number of `λ` coordinates.
+    pub fn dimension(&self) -> usize {
+        self.null.ncols()
+    }
+
+    /// `f_p`, the minimum-norm balancing tensions (N; may be outside the limits).
+    pub fn particular(&self) -> &[f64] {
+        &self.particular
+    }
+
+    /// `N` (m × dimension), an orthonormal basis of `null(J_cᵀ)`.
+    pub fn null_basis(&self) -> MatRef<'_, f64> {
+        self.null.as_ref()
+    }
+
+    /// `f_min` of every cable, N.
+    pub fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+
+    /// `f_max` of every cable, N.
+    pub fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+
+    /// The tensions at `λ`: `f = f_p + N λ` (into `out`, m).
+    ///
+    /// # Errors
+    /// [`StaticsError::DimensionMismatch`].
+    pub fn tensions(&self, lambda: &[f64], out: &mut [f64]) -> Result<(), StaticsError> {
+        let (m, k) = (self.cable_count(), self.dimension());
+        if lambda.len() != k {
+            return Err(StaticsError::DimensionMismatch {
+                what: "λ",
+                expected: k,
+                got: lambda.len(),
+            });
+        }
+        if out.len() != m {
+            return Err(StaticsError::DimensionMismatch {
+                what: "tensions",
+                expected: m,
+                got: out.len(),
+            });
+        }
+        for (c, f) in out.iter_mut().enumerate() {
+            *f = self.particular[c] + (0..k).map(|i| self.null[(c, i)] * lambda[i]).sum::<f64>();
+        }
+        Ok(())
+    }
+
+    /// The coordinates `λ = Nᵀ (f − f_p)` of a tension vector (its part in the set).
+    pub fn coordinates(&self, tensions: &[f64]) -> Vec<f64> {
+        (0..self.dimension())
+            .map(|i| {
+                (0..self.cable_count().min(tensions.len()))
+                    .map(|c| self.null[(c, i)] * (tensions[c] - self.particular[c]))
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// `J_c⁺ w`: the joint motion `δq` whose cable length changes `J_c δq` are the part of `w`
+    /// (m) in the range of `J_c`.
+    pub fn joint_motion(&self, w: &[f64]) -> Vec<f64> {
+        let dof = self.v_range.nrows();
+        let y: Vec<f64> = (0..self.singular.len())
+            .map(|i| {
+                (0..self.cable_count().min(w.len()))
+                    .map(|c| self.u_range[(c, i)] * w[c])
+                    .sum::<f64>()
+                    / self.singular[i]
+            })
+            .collect();
+        (0..dof).map(|d| (0..y.len()).map(|i| self.v_range[(d, i)] * y[i]).sum()).collect()
+    }
+
+    /// Whether the cables are in force closure at this pose: some strictly positive tension
+    /// vector in `null(J_cᵀ)` (every torque can then be held with high enough tensions). One
+    /// small LP ([`crate::policy`]); a property, not a condition of feasibility.
+    ///
+    /// # Errors
+    /// [`StaticsError::Solver`] when the LP solver fails.
+    pub fn force_closure(&self) -> Result<bool, StaticsError> {
+        crate::policy::force_closure(self)
+    }
+}
+
+/// Euclidean norm.
+pub(crate) fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// The joints (0-based) whose DOFs carry at least a tenth of the largest component of a joint
+/// motion `direction` (dof).
+pub(crate) fn joints_along(direction: &[f64], groups: &[Range<usize>]) -> Vec<usize> {
+    let largest = direction.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    groups
+        .iter()
+        .enumerate()
+        .filter(|(_, g)| {
+            (g.start..g.end).any(|d| direction.get(d).is_some_and(|v| v.abs() >= 0.1 * largest))
+        })
+        .map(|(j, _)| j)
+        .collect()
+}
