@@ -203,7 +203,7 @@ fn bad_cables_name_the_cable() {
     let far = CABLES.replace("<link>1</link>", "<link>5</link>");
     let e = run(&bodies("U_XY", "0.2", "0"), &far, None);
     assert!(matches!(&e, ImportError::UnknownAttachmentLink { link: 5, links: 1, .. }), "{e:?}");
-    assert_eq!(at(&e), ("c.xml", 7, 22));
+    assert_eq!(at(&e), ("c.xml", 7, 21));
 
     let pulley = CABLES.replacen("<attachment>", "<base_rotating_pulley>", 1).replacen(
         "</attachment>",
