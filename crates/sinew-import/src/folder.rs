@@ -97,7 +97,7 @@ pub(crate) fn build(model: &CasprModel, options: &ImportOptions) -> Result<Robot
     if !missing_limits.is_empty() {
         warnings.push(format!(
             "link(s) {} state no q_min/q_max: joint limits ±π written (CASPR's q_lb/q_ub)",
-            missing_limits.join(", ")
+            names_list(&missing_limits.iter().map(String::as_str).collect::<Vec<_>>())
         ));
     }
     let springs: Vec<&str> = model
@@ -110,20 +110,28 @@ pub(crate) fn build(model: &CasprModel, options: &ImportOptions) -> Result<Robot
     if !springs.is_empty() {
         warnings.push(format!(
             "cable(s) {}: <cable_linear_spring> stiffness K ignored: Sinew's cable stiffness is E·A/l from the material and lengths",
-            springs.join(", ")
+            names_list(&springs)
+        ));
+    }
+    let reversed: Vec<&str> =
+        model.cable_set.cables.iter().filter(|c| reversed(c)).map(|c| c.name.as_str()).collect();
+    if !reversed.is_empty() {
+        warnings.push(format!(
+            "cable(s) {}: attachments listed from the tip towards the base: written base first (the same polyline; sinew-routing anchors a cable at its last hole)",
+            names_list(&reversed)
         ));
     }
     let on_base: Vec<&str> = model
         .cable_set
         .cables
         .iter()
-        .filter(|c| c.attachments.last().is_some_and(|a| a.link == 0))
+        .filter(|c| c.attachments.iter().all(|a| a.link == 0))
         .map(|c| c.name.as_str())
         .collect();
     if !on_base.is_empty() {
         warnings.push(format!(
-            "cable(s) {} end on the base (link 0): sinew-routing needs each cable's last hole (its anchor) on a moving link",
-            on_base.join(", ")
+            "cable(s) {} lie on the base (link 0) only: sinew-routing needs each cable's anchor on a moving link",
+            names_list(&on_base)
         ));
     }
 
@@ -197,6 +205,7 @@ fn check_options(options: &ImportOptions) -> Result<()> {
 fn link_names(links: &[Link], warnings: &mut Vec<String>) -> Vec<String> {
     let mut used: HashSet<String> = [BASE_LINK, TIP_LINK].into_iter().map(str::to_owned).collect();
     let mut names = vec![BASE_LINK.to_owned()];
+    let mut renamed: Vec<String> = Vec::new();
     for link in links {
         let wanted = sanitize(&link.name);
         let mut name = wanted.clone();
@@ -212,14 +221,38 @@ fn link_names(links: &[Link], warnings: &mut Vec<String>) -> Vec<String> {
             }
         }
         if name != link.name {
-            warnings
-                .push(format!("link {} `{}` is named `{name}` in the URDF", link.num, link.name));
+            renamed.push(format!("`{}` → `{name}`", link.name));
         }
         used.insert(name.clone());
         used.insert(format!("{name}_cross"));
         names.push(name);
     }
+    if !renamed.is_empty() {
+        warnings.push(format!(
+            "link names made URDF-safe and unique: {}",
+            names_list(&renamed.iter().map(String::as_str).collect::<Vec<_>>())
+        ));
+    }
     names
+}
+
+/// Whether a cable's attachments run from the tip towards the base (its first attachment on a
+/// later link than its last): such a cable is written reversed, base first.
+fn reversed(cable: &Cable) -> bool {
+    match (cable.attachments.first(), cable.attachments.last()) {
+        (Some(first), Some(last)) => first.link > last.link,
+        _ => false,
+    }
+}
+
+/// At most six names, then how many more.
+fn names_list(names: &[&str]) -> String {
+    const SHOWN: usize = 6;
+    let mut out = names.iter().take(SHOWN).copied().collect::<Vec<_>>().join(", ");
+    if names.len() > SHOWN {
+        out.push_str(&format!(" and {} more", names.len() - SHOWN));
+    }
+    out
 }
 
 /// Where the tip sits: (link number, point in its frame, what it is).
@@ -318,19 +351,19 @@ fn tension_limits(
     if !clamped.is_empty() {
         warnings.push(format!(
             "cable(s) {}: force_min < 0 clamped to 0 N (sinew-routing needs 0 ≤ f_min < f_max; a cable cannot push)",
-            clamped.join(", ")
+            names_list(&clamped)
         ));
     }
     if !zero.is_empty() {
         warnings.push(format!(
             "cable(s) {}: force_min = 0 N, a placeholder? The tension distribution may then slacken cables; give --tension-limits for a real minimum",
-            zero.join(", ")
+            names_list(&zero)
         ));
     }
     if !placeholder.is_empty() {
         warnings.push(format!(
             "cable(s) {}: force_max ≥ {PLACEHOLDER_FORCE_MAX:e} N, a placeholder rather than a rating? Give --tension-limits for the cables' real limits",
-            placeholder.join(", ")
+            names_list(&placeholder)
         ));
     }
     let first = each[0];
@@ -597,7 +630,11 @@ fn write_cables_toml(
             let _ = writeln!(c, "tension_limits = {}", toml_vec(&each[k]));
         }
         let _ = writeln!(c, "holes = [");
-        for a in &cable.attachments {
+        let mut holes: Vec<_> = cable.attachments.iter().collect();
+        if reversed(cable) {
+            holes.reverse();
+        }
+        for a in holes {
             let _ = writeln!(
                 c,
                 "  {{ link = {}, point = {} }},",
