@@ -57,7 +57,7 @@ fn imports_a_model_that_the_library_and_the_routing_command_load() {
         .collect();
     assert_eq!(names, ["cables.toml", "robot.toml", "universal.urdf"]);
     // Nothing else beside it: the temporary folder was renamed.
-    assert_eq!(entries(tmp.path()), [out.clone()]);
+    assert_eq!(entries(tmp.path()), std::slice::from_ref(&out));
 
     let robot = sinew::robot::load(&out).unwrap();
     assert_eq!(robot.dof(), 4);
