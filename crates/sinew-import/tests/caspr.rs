@@ -352,3 +352,28 @@ fn placeholder_and_negative_limits_are_clamped_and_reported() {
     let robot = sinew_robot::load(dir.path()).unwrap();
     sinew_routing::load(dir.path(), &robot).unwrap();
 }
+
+#[test]
+fn a_cable_listed_tip_first_is_written_base_first() {
+    let base = "<link>0</link>\n          <location>0.019107 0.00591 0</location>";
+    let link = "<link>1</link>\n          <location>0.019107 0.00591 0.1</location>";
+    let text = read("universal_cables.xml")
+        .replacen(base, "@", 1)
+        .replacen(link, base, 1)
+        .replacen("@", link, 1);
+    let bodies = read("universal_bodies.xml");
+    let folder = import_caspr(
+        Source { name: "b", text: &bodies },
+        Source { name: "c", text: &text },
+        None,
+        &ImportOptions::named("uu"),
+    )
+    .unwrap();
+    assert!(folder.warnings.iter().any(|w| w.contains("a1: attachments listed from the tip")));
+    let dir = write(&folder);
+    let robot = sinew_robot::load(dir.path()).unwrap();
+    let routing = sinew_routing::load(dir.path(), &robot).unwrap();
+    let a1 = routing.view().cables.into_iter().find(|c| c.name == "a1").unwrap();
+    let links: Vec<&str> = a1.holes.iter().map(|h| h.link).collect();
+    assert_eq!(links, ["base_link", "base_side"]);
+}
