@@ -48,6 +48,59 @@ pub enum Command {
     /// feasible tensions at each point, empty
     /// (null in JSON) where the torque cannot be held.
     Sweep(SweepArgs),
+    /// Write a Sinew robot folder from another tool's model files.
+    #[command(subcommand)]
+    Import(ImportSource),
+}
+
+/// The tools `sinew import` reads.
+#[derive(Debug, Subcommand)]
+pub enum ImportSource {
+    /// A CASPR model (bodies and cables XML, optionally operational spaces) as a robot folder:
+    /// `<name>.urdf`, robot.toml, cables.toml (explicit holes).
+    ///
+    /// R_X/R_Y/R_Z links become one revolute joint, U_XY/U_XZ/U_YZ two (the second with zero
+    /// translation, a massless cross link between). The folder is written beside --out and
+    /// renamed into place, so nothing is written on failure; an existing non-empty --out is
+    /// refused. Warnings go to standard error.
+    Caspr(CasprArgs),
+}
+
+/// `sinew import caspr`.
+#[derive(Debug, Args)]
+pub struct CasprArgs {
+    /// CASPR bodies file (`<bodies_system>`).
+    #[arg(long, value_name = "FILE")]
+    pub bodies: PathBuf,
+    /// CASPR cables file (`<cables>`).
+    #[arg(long, value_name = "FILE")]
+    pub cables: PathBuf,
+    /// CASPR operational spaces file: its default set's point is the tip (else the last
+    /// link's end location).
+    #[arg(long, value_name = "FILE")]
+    pub operational_spaces: Option<PathBuf>,
+    /// The cable set's id (default: the file's default_cable_set).
+    #[arg(long, value_name = "ID")]
+    pub cable_set: Option<String>,
+    /// Young's modulus of the cables, Pa (default 200e9, steel).
+    #[arg(long, value_name = "PA", allow_hyphen_values = true)]
+    pub youngs_modulus: Option<String>,
+    /// Cable diameter, m (default 1e-3).
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub diameter: Option<String>,
+    /// Free length from the actuator to the first hole, m (default 0.5).
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub free_length: Option<String>,
+    /// Tension limits of every cable, N, instead of the file's force_min/force_max.
+    #[arg(long, value_name = "MIN,MAX", allow_hyphen_values = true)]
+    pub tension_limits: Option<String>,
+    /// The robot's name (URDF name and file name; default: the bodies file's name without
+    /// `_bodies.xml`).
+    #[arg(long, value_name = "NAME")]
+    pub name: Option<String>,
+    /// The robot folder to create (must not exist, or be empty).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 /// Which routing file of the robot folder to use.

@@ -4,7 +4,8 @@
 //! - `sinew routing`: the expanded routing and the joints;
 //! - `sinew joint`: one joint's feasible tension interval and stiffness range;
 //! - `sinew arm`: T0, tensions, K_q, K_W, C_x, K_x, K_fd, the ellipsoid and stability;
-//! - `sinew sweep`: a joint's min/max stiffness maps over its angles (Fig. 5).
+//! - `sinew sweep`: a joint's min/max stiffness maps over its angles (Fig. 5);
+//! - `sinew import caspr`: a robot folder from a CASPR model's XML files.
 //!
 //! Errors print one line, `sinew: <message>`, on standard error and exit with 2 (bad input)
 //! or 1 (the model has no answer, e.g. an infeasible load); never a panic.
@@ -12,6 +13,7 @@
 mod arm_cmd;
 mod cli;
 mod error;
+mod import_cmd;
 mod input;
 mod joint_cmd;
 mod output;
@@ -22,7 +24,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
-use crate::cli::{Cli, Command};
+use crate::cli::{Cli, Command, ImportSource};
 use crate::error::CliError;
 
 fn run(cli: &Cli) -> Result<(), CliError> {
@@ -31,6 +33,7 @@ fn run(cli: &Cli) -> Result<(), CliError> {
         Command::Joint(args) => joint_cmd::run(args),
         Command::Arm(args) => arm_cmd::run(args),
         Command::Sweep(args) => sweep_cmd::run(args),
+        Command::Import(ImportSource::Caspr(args)) => import_cmd::caspr(args),
     }
 }
 
