@@ -36,8 +36,12 @@ struct JointOut {
     lambda: [f64; 2],
     /// `f_p`, the minimum-norm tensions (N).
     particular: Vec<f64>,
-    /// `n`, the unit null direction of `J_cᵀ` (every component positive).
+    /// `n`, the unit null direction of `J_cᵀ` (components summing to ≥ 0; every component
+    /// positive in force closure).
     null_direction: Vec<f64>,
+    /// Whether the joint's cables are in force closure at this pose (`n` strictly positive):
+    /// a property reported, not required; without it the interval may still be non-empty.
+    force_closure: bool,
     /// `[f(λ_min), f(λ_max)]`, N.
     tensions: [Vec<f64>; 2],
     /// `[at λ_min, at λ_max]`, 2 × 2 each, N m/rad.
@@ -105,6 +109,7 @@ pub fn run(args: &JointArgs) -> Result<(), CliError> {
         lambda: [interval.lambda_min, interval.lambda_max],
         particular: na_vec(&interval.particular),
         null_direction: na_vec(&interval.null),
+        force_closure: interval.force_closure(),
         tensions: [na_vec(&f_lo), na_vec(&f_hi)],
         k_controllable: [na_rows(&range.controllable[0]), na_rows(&range.controllable[1])],
         k_inherent: [na_rows(&range.inherent), na_rows(&range.inherent)],
@@ -143,6 +148,11 @@ fn render(out: &JointOut) -> String {
         out.tension_limits[0],
         out.tension_limits[1]
     ));
+    if !out.force_closure {
+        s.push_str(
+            "  not in force closure at this pose (n has a component ≤ 0): some tension slackens as others rise\n\n",
+        );
+    }
     s.push_str("Feasible tensions f = f_p + λ n, λ ∈ [λ_min, λ_max] (N):\n");
     let mut header = vec!["".to_owned(), "λ".to_owned()];
     header.extend(out.cables.iter().map(|c| format!("f {c}")));

@@ -378,18 +378,19 @@ fn tension_limits(
     Ok(Limits { common: [lo, hi], per_cable: Some(each) })
 }
 
-/// Sinew reads two consecutive revolute joints with a zero-translation origin and a massless
-/// body between them as one universal joint: say when two CASPR `R_*` links will be read so.
+/// Sinew reads two consecutive revolute joints with a massless body between them and
+/// non-parallel axes as one universal joint (`sinew_robot::Robot::joint_groups`): say when two
+/// CASPR `R_*` links will be read so.
 fn joint_group_warnings(links: &[Link], warnings: &mut Vec<String>) {
     for pair in links.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         if a.joint.dof() == 1
             && b.joint.dof() == 1
             && a.mass == 0.0
-            && b.parent_location == [0.0; 3]
+            && a.joint.axes()[0] != b.joint.axes()[0]
         {
             warnings.push(format!(
-                "links {} and {}: two revolute joints at one point with a massless link between: Sinew reads them as one universal joint",
+                "links {} and {}: two revolute joints with a massless link between: Sinew reads them as one universal joint",
                 a.num, b.num
             ));
         }

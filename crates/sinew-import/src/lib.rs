@@ -39,7 +39,7 @@
 //!   (`R_pe = R_first(q1) · R_second(q2)`: about the first axis, then about the rotated second
 //!   one, `r_rel = 0`) become two: the first at `r_Parent` into a massless `<link>_cross`, the
 //!   second with zero translation into the link. Sinew reads two consecutive revolute joints
-//!   with a zero-translation origin and a massless body between them as one universal joint,
+//!   with non-parallel axes and a massless body between them as one universal joint,
 //!   and a lone revolute joint as a 1-DOF joint. Every other type (`S_EULER_XYZ`, `P_*`,
 //!   `PLANAR_*`, `R_AXIS`, `SPATIAL_*`, …) is [`ImportError::UnsupportedJoint`]. Limits:
 //!   `q_min`/`q_max` (one value per coordinate); where the file has none, ±π (CASPR's

@@ -35,4 +35,4 @@ pub use display::Compact;
 pub use error::{Result, RobotError};
 pub use generate::UniformChain;
 pub use kinematics::RobotData;
-pub use model::{Body, BodyPoint, COINCIDENT_ORIGIN, ChainSettings, Joint, LinkPlacement, Robot};
+pub use model::{Body, BodyPoint, ChainSettings, Joint, LinkPlacement, Robot};

@@ -81,14 +81,11 @@ pub struct Robot {
     pub(crate) dof_joint: Vec<usize>,
 }
 
-/// A joint origin closer than this to its parent body's frame origin, m, counts as coincident
-/// when grouping revolute joints ([`Robot::joint_groups`]).
-pub const COINCIDENT_ORIGIN: f64 = 1e-12;
-
 /// The arm's joints as groups of revolute joints (see [`Robot::joint_groups`]): revolute joint
-/// `k` and `k + 1` form one universal joint when the body between them is massless, joint
-/// `k + 1` sits at that body's origin (its origin has no translation) and their axes are not
-/// parallel; any other revolute joint is a 1-DOF joint of its own. Greedy from the base.
+/// `k` and `k + 1` form one universal joint when the body between them is massless (the cross
+/// of a universal joint: no inertial, no attached link with mass) and their axes are not
+/// parallel; any other revolute joint is a 1-DOF joint of its own. Greedy from the base. The
+/// axes need not intersect (a universal joint with offset axes is still one joint).
 pub(crate) fn group_joints(joints: &[Joint], bodies: &[Body]) -> Vec<Range<usize>> {
     let mut groups = Vec::new();
     let mut k = 0;
@@ -97,9 +94,7 @@ pub(crate) fn group_joints(joints: &[Joint], bodies: &[Body]) -> Vec<Range<usize
             let next = &joints[k + 1];
             let between = &bodies[k + 1];
             let second_axis = next.origin.rotation * next.axis.into_inner();
-            between.mass <= 0.0
-                && next.origin.translation.vector.norm() <= COINCIDENT_ORIGIN
-                && joints[k].axis.cross(&second_axis).norm() > 1e-9
+            between.mass <= 0.0 && joints[k].axis.cross(&second_axis).norm() > 1e-9
         };
         let len = if pairs { 2 } else { 1 };
         groups.push(k..k + len);
@@ -134,7 +129,7 @@ impl Robot {
     }
 
     /// The arm's joints, base first, each as the range of its revolute joints in `Q`: `k..k + 2`
-    /// for a universal joint (two consecutive revolute joints with intersecting axes and a
+    /// for a universal joint (two consecutive revolute joints with non-parallel axes and a
     /// massless cross between them, as a URDF writes a universal joint), `k..k + 1` for a lone
     /// revolute joint. Tension levels, cable ownership and the per-joint outputs are counted
     /// in these joints. The paper's arms are all universal (`2n` DOF, joint `i` owning

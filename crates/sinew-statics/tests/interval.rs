@@ -100,18 +100,44 @@ fn a_torque_beyond_the_limits_is_infeasible_and_names_the_joint() {
 }
 
 #[test]
-fn lost_force_closure_is_a_typed_outcome() {
-    // Null direction of Jᵀ along [1, −1, 0]: cables 1 and 2 pull the same way.
-    let jacobian = Matrix3x2::new(0.02, 0.0, 0.02, 0.0, 0.0, 0.02);
-    let err = tension_interval(0, &jacobian, &Vector2::new(0.1, 0.1), LIMITS).unwrap_err();
+fn lost_force_closure_is_reported_not_refused() {
+    // Null direction of Jᵀ along [1, −1, 0]: cables 1 and 2 pull the same way, so raising one
+    // slackens the other; cable 3 keeps its tension whatever λ.
+    let jacobian = Matrix3x2::new(0.02, 0.0, 0.02, 0.0, 0.0, -0.02);
+    // A torque these cables hold within [20, 600] N: an interval, not an error.
+    let tau = Vector2::new(-4.0, 2.0);
+    let interval = tension_interval(0, &jacobian, &tau, LIMITS).unwrap();
+    assert!(!interval.force_closure());
+    assert!(interval.null[2].abs() < 1e-15 && interval.null.sum() >= 0.0, "{:?}", interval.null);
+    assert!(interval.width() > 0.0);
+    for lambda in [
+        interval.lambda_min,
+        0.5 * (interval.lambda_min + interval.lambda_max),
+        interval.lambda_max,
+    ] {
+        let f = interval.tensions(lambda);
+        assert!(f.iter().all(|&v| (LIMITS.f_min..=LIMITS.f_max).contains(&v)), "{f:?}");
+        let residual = tau + jacobian.transpose() * f;
+        assert!(residual.norm() <= 1e-12 * tau.norm(), "{residual:?}");
+    }
+    // Each end has one cable on a limit: cable 1 or 2 on f_min or f_max.
+    let (low, high) = interval.ends();
+    let on_limit =
+        |f: nalgebra::Vector3<f64>| f.iter().any(|&v| v == LIMITS.f_min || v == LIMITS.f_max);
+    assert!(on_limit(low) && on_limit(high), "{low:?} {high:?}");
+    // Cable 3 must keep 100 N, whatever λ: a torque needing 1000 N is refused, naming it.
+    let err = tension_interval(0, &jacobian, &Vector2::new(-4.0, 20.0), LIMITS).unwrap_err();
     assert!(
         matches!(
             err,
-            StaticsError::Infeasible { reason: InfeasibleReason::NoForceClosure { .. }, .. }
+            StaticsError::Infeasible {
+                reason: InfeasibleReason::FixedTension { cable: 2, .. },
+                ..
+            }
         ),
         "{err:?}"
     );
-    assert!(err.to_string().contains("force closure"), "{err}");
+    assert!(err.to_string().contains("cable 3 must keep the tension 1000 N"), "{err}");
 }
 
 #[test]
