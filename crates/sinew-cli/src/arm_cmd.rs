@@ -3,9 +3,10 @@
 use nalgebra::Vector6;
 use serde::Serialize;
 use sinew::indicators::StiffnessEllipsoid;
+use sinew::statics::TensionChoice;
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
-use crate::cli::ArmArgs;
+use crate::cli::{ArmArgs, Policy};
 use crate::error::{CliError, library_error};
 use crate::input::{check_limits, load, numbers_n, to_radians};
 use crate::output::{
@@ -23,7 +24,18 @@ struct ArmOut {
     gravity: [f64; 3],
     q: Vec<f64>,
     wrench: Vec<f64>,
-    levels: Vec<f64>,
+    /// `levels` (the closed form) or a policy's name.
+    policy: &'static str,
+    /// Null when a policy chose the tensions.
+    levels: Option<Vec<f64>>,
+    /// The policy's objective: Σ f (N), |f| (N) or the least distance to a limit (N); null
+    /// with levels.
+    policy_objective: Option<f64>,
+    /// Whether some strictly positive tension vector balances no load (every torque reachable
+    /// with high enough tensions): a property of the pose and routing, reported.
+    force_closure: bool,
+    /// The dimension of the equilibrium set `f = f_p + N λ` (cables − rank of J_c).
+    null_space_dimension: usize,
     cables: Vec<String>,
     t0: Vec<f64>,
     tensions: Vec<f64>,
@@ -80,12 +92,12 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
     let dof = robot.dof();
-    let joints = dof / 2;
+    let joints = robot.joint_count();
     let mut q = numbers_n(
         "--q",
         &args.q,
         dof,
-        &format!("angles (2 per universal joint, {joints} joints)"),
+        &format!("angles (one per revolute joint, {joints} joints)"),
     )?;
     to_radians(&mut q, args.deg);
     check_limits(robot, &q)?;
@@ -93,21 +105,33 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
         None => vec![0.0; 6],
     };
-    let levels = match &args.levels {
-        Some(text) => numbers_n(
+    // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
+    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
+    let levels = match (&args.levels, args.policy) {
+        (Some(text), _) => Some(numbers_n(
             "--levels",
             text,
             joints,
-            &format!("tension levels (one per universal joint, {joints} joints)"),
-        )?,
-        None => vec![0.0; joints],
+            &format!("tension levels (one per joint, {joints} joints)"),
+        )?),
+        (None, None) if arm.statics().has_levels() => Some(vec![0.0; joints]),
+        (None, _) => None,
     };
-    // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
-    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
+    let policy = args.policy.unwrap_or(Policy::LeastTotal).tension_policy();
+    let choice = match &levels {
+        Some(levels) => TensionChoice::Levels(levels),
+        None => TensionChoice::Policy(policy),
+    };
     let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_column_slice(&wrench);
     let mut notes = Vec::new();
-    let outcome = arm.evaluate(&mut data, &q, &f0, &levels);
+    if args.levels.is_none() && args.policy.is_none() && levels.is_none() {
+        notes.push(
+            "tension levels need three cables per universal joint: the tensions are the policy least-total"
+                .to_owned(),
+        );
+    }
+    let outcome = arm.evaluate_with(&mut data, &q, &f0, choice);
     let (stable, full_rank) = match outcome {
         Ok(()) => (true, true),
         Err(StiffnessError::Unstable { .. }) => {
@@ -154,10 +178,14 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         (None, None, None)
     };
     let cables: Vec<String> = routing.cables().iter().map(|c| c.name.clone()).collect();
+    let set = arm.equilibrium_set(&data).map_err(library_error)?;
+    let force_closure = set.force_closure().map_err(library_error)?;
+    let policy_objective = data.statics.distribution.as_ref().map(|d| d.objective);
+    let level_list = levels.clone().unwrap_or_default();
     let intervals = data
         .intervals()
         .iter()
-        .zip(&levels)
+        .zip(&level_list)
         .map(|(interval, &level)| {
             let (lo, hi) = interval.ends();
             IntervalOut {
@@ -182,7 +210,11 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         gravity: [g.x, g.y, g.z],
         q,
         wrench,
+        policy: if levels.is_some() { "levels" } else { policy.name() },
         levels,
+        policy_objective,
+        force_closure,
+        null_space_dimension: set.dimension(),
         cables,
         t0: data.statics.t0.clone(),
         tensions: data.tensions().to_vec(),
@@ -206,7 +238,6 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
 
 fn render(out: &ArmOut, routing: &sinew::routing::Routing) -> String {
     let mut s = String::new();
-    let dof = out.q.len();
     s.push_str(&format!(
         "arm `{}` ({}: {}), gravity {} m/s²\n",
         out.robot,
@@ -219,9 +250,40 @@ fn render(out: &ArmOut, routing: &sinew::routing::Routing) -> String {
         "  F0 = {} (N, N m; exerted by the end, base frame)\n",
         Fmt::Fixed(4).list(&out.wrench)
     ));
-    s.push_str(&format!("  tension levels = {}\n\n", Fmt::Fixed(3).list(&out.levels)));
+    match (&out.levels, out.policy_objective) {
+        (Some(levels), _) => {
+            s.push_str(&format!("  tension levels = {}\n", Fmt::Fixed(3).list(levels)));
+        }
+        (None, objective) => s.push_str(&format!(
+            "  tensions by the policy {} (objective {} N)\n",
+            out.policy,
+            objective.map_or_else(|| "-".to_owned(), |v| Fmt::Fixed(4).num(v))
+        )),
+    }
+    s.push_str(&format!(
+        "  equilibrium set f = f_p + N λ of dimension {}; force closure: {}\n\n",
+        out.null_space_dimension,
+        if out.force_closure { "yes" } else { "no (reported, not required)" }
+    ));
+    if out.intervals.is_empty() {
+        s.push_str("Cables: tensions (N) within their limits:\n");
+        let mut t = Table::new(&["cable", "joint", "f", "f_min", "f_max"]).left(&[0]);
+        for (c, cable) in routing.cables().iter().enumerate() {
+            t.row(vec![
+                out.cables[c].clone(),
+                format!("{}", cable.joint + 1),
+                Fmt::Fixed(3).num(out.tensions[c]),
+                Fmt::Fixed(1).num(cable.tension_limits[0]),
+                Fmt::Fixed(1).num(cable.tension_limits[1]),
+            ]);
+        }
+        s.push_str(&t.render(2));
+        s.push('\n');
+    }
 
-    s.push_str("Joints (numbered from 1): T0 = T_g + J_xᵀ F0 (N m), feasible λ, tensions (N), K (N m/rad):\n");
+    if !out.intervals.is_empty() {
+        s.push_str("Joints (numbered from 1): T0 = T_g + J_xᵀ F0 (N m), feasible λ, tensions (N), K (N m/rad):\n");
+    }
     let mut t = Table::new(&[
         "joint", "T0 x", "T0 y", "λ_min", "λ_max", "level", "cables", "f1", "f2", "f3", "K_x",
         "K_y",
@@ -254,8 +316,10 @@ fn render(out: &ArmOut, routing: &sinew::routing::Routing) -> String {
         row.push(diag(1).map(|x| Fmt::Fixed(4).num(x)).unwrap_or_default());
         t.row(row);
     }
-    s.push_str(&t.render(2));
-    let ql = q_labels(dof);
+    if !out.intervals.is_empty() {
+        s.push_str(&t.render(2));
+    }
+    let ql = q_labels(routing.joint_groups());
     let cl = cartesian_labels();
     s.push('\n');
     s.push_str(&matrix(

@@ -103,6 +103,28 @@ pub struct CasprArgs {
     pub out: PathBuf,
 }
 
+/// A tension policy (`--policy`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Policy {
+    /// Least total tension Σ f (LP).
+    LeastTotal,
+    /// Least 2-norm |f| (QP).
+    LeastNorm,
+    /// Farthest from the limits: the greatest least distance of a tension to f_min or f_max.
+    Safest,
+}
+
+impl Policy {
+    /// The library's policy.
+    pub fn tension_policy(self) -> sinew::statics::TensionPolicy {
+        match self {
+            Policy::LeastTotal => sinew::statics::TensionPolicy::LeastTotal,
+            Policy::LeastNorm => sinew::statics::TensionPolicy::LeastNorm,
+            Policy::Safest => sinew::statics::TensionPolicy::Safest,
+        }
+    }
+}
+
 /// Which routing file of the robot folder to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Model {
@@ -178,8 +200,8 @@ pub struct JointArgs {
 pub struct ArmArgs {
     #[command(flatten)]
     pub common: Common,
-    /// The pose: 2n angles Q1,...,Q2n, base first, the first then the second axis of each
-    /// universal joint (rad; degrees with --deg).
+    /// The pose: one angle per revolute joint, base first, the first then the second axis of
+    /// each universal joint (rad; degrees with --deg).
     #[arg(long, value_name = "Q1,...,Q2n", allow_hyphen_values = true)]
     pub q: String,
     /// F0, the wrench the end-effector exerts on its environment, base frame:
@@ -187,9 +209,14 @@ pub struct ArmArgs {
     #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
     pub wrench: Option<String>,
     /// Tension level of each joint in [0, 1] along its feasible interval (0: least total
-    /// tension, 1: most), S1,...,Sn base first. Default all 0.
-    #[arg(long, value_name = "S1,...,Sn", allow_hyphen_values = true)]
+    /// tension, 1: most), S1,...,Sn base first: the paper's closed form, for three cables per
+    /// universal joint. Default all 0 where it applies, else `--policy least-total`.
+    #[arg(long, value_name = "S1,...,Sn", allow_hyphen_values = true, conflicts_with = "policy")]
     pub levels: Option<String>,
+    /// Choose the tensions by a policy over every tension vector that balances the load (any
+    /// cable set): least total tension, least 2-norm, or farthest from the limits.
+    #[arg(long, value_enum)]
+    pub policy: Option<Policy>,
     /// Ignore gravity (zero gravity vector instead of robot.toml's).
     #[arg(long)]
     pub no_gravity: bool,

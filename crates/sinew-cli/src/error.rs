@@ -84,7 +84,8 @@ fn option_of(e: &sinew::Error) -> Option<String> {
         },
         sinew::Error::Indicators(i) => match i {
             IndicatorError::NoSuchJoint { joint, .. } => Some(format!("--joint {}", joint + 1)),
-            IndicatorError::NotThreeCables { joint, .. } => Some(format!("--joint {}", joint + 1)),
+            IndicatorError::NotThreeCables { joint, .. }
+            | IndicatorError::NotUniversal { joint, .. } => Some(format!("--joint {}", joint + 1)),
             IndicatorError::GridTooSmall { points, .. } => Some(format!("--grid {points}")),
             IndicatorError::GridRange { .. } => Some("--joint (its angle limits)".to_owned()),
             _ => None,

@@ -224,6 +224,15 @@ pub fn cartesian_labels() -> Vec<String> {
 }
 
 /// Labels of the revolute joints (`q11`, `q12`, `q21`, …: joint number from 1, then axis).
-pub fn q_labels(dof: usize) -> Vec<String> {
-    (0..dof).map(|k| format!("q{}{}", k / 2 + 1, k % 2 + 1)).collect()
+pub fn q_labels(groups: &[std::ops::Range<usize>]) -> Vec<String> {
+    groups
+        .iter()
+        .enumerate()
+        .flat_map(|(j, g)| {
+            let single = g.len() == 1;
+            (0..g.len()).map(move |k| {
+                if single { format!("q{}", j + 1) } else { format!("q{}{}", j + 1, k + 1) }
+            })
+        })
+        .collect()
 }

@@ -6,7 +6,7 @@ use sinew::routing::{RoutingModel, RoutingView};
 use crate::cli::RoutingArgs;
 use crate::error::CliError;
 use crate::input::{Loaded, load};
-use crate::output::{Fmt, Table, emit, print_json};
+use crate::output::{Fmt, Table, emit, print_json, q_labels};
 
 /// The JSON document of `sinew routing`: the robot's files and joints, then the library's
 /// view of the routing ([`sinew::routing::Routing::view`], flattened: `robot`, `source`,
@@ -20,6 +20,10 @@ struct RoutingOut<'a> {
     gravity: [f64; 3],
     routing_file: String,
     joints: Vec<JointOut<'a>>,
+    /// The arm's joints as ranges of revolute joints (`[start, end)`): a universal joint has
+    /// two, a revolute joint one.
+    #[serde(skip)]
+    groups: Vec<std::ops::Range<usize>>,
     #[serde(flatten)]
     routing: RoutingView<'a>,
 }
@@ -30,8 +34,10 @@ struct JointOut<'a> {
     /// Index in Q, 0-based.
     index: usize,
     name: &'a str,
-    /// The universal joint it belongs to, 0-based.
-    universal_joint: usize,
+    /// The joint it belongs to, 0-based (a universal joint's two revolute joints share it).
+    joint: usize,
+    /// Its place in that joint: 0 (first axis) or 1 (second axis of a universal joint).
+    axis_index: usize,
     /// Unit axis in the joint frame.
     axis: [f64; 3],
     lower: f64,
@@ -62,12 +68,15 @@ fn document(loaded: &Loaded) -> RoutingOut<'_> {
             .map(|(index, j)| JointOut {
                 index,
                 name: &j.name,
-                universal_joint: index / 2,
+                joint: robot.joint_of_dof(index).unwrap_or(0),
+                axis_index: index
+                    - robot.joint_groups()[robot.joint_of_dof(index).unwrap_or(0)].start,
                 axis: [j.axis.x, j.axis.y, j.axis.z],
                 lower: j.lower,
                 upper: j.upper,
             })
             .collect(),
+        groups: robot.joint_groups().to_vec(),
         routing: routing.view(),
     }
 }
@@ -95,13 +104,14 @@ fn render(out: &RoutingOut<'_>) -> String {
         out.routing.tension_limits[0],
         out.routing.tension_limits[1]
     ));
-    s.push_str("Revolute joints, base first (universal joints numbered from 1), limits in rad:\n");
+    s.push_str("Revolute joints, base first (joints numbered from 1), limits in rad:\n");
     let mut joints = Table::new(&["q", "name", "joint", "axis", "lower", "upper"]).left(&[1]);
-    for j in &out.joints {
+    let labels = q_labels(&out.groups);
+    for (j, label) in out.joints.iter().zip(labels) {
         joints.row(vec![
-            format!("q{}{}", j.universal_joint + 1, j.index % 2 + 1),
+            label,
             j.name.to_owned(),
-            format!("{}", j.universal_joint + 1),
+            format!("{}", j.joint + 1),
             Fmt::Fixed(3).list(&j.axis),
             Fmt::Fixed(5).num(j.lower),
             Fmt::Fixed(5).num(j.upper),

@@ -1030,3 +1030,98 @@ fn any_universal_joint_axes_load_and_are_named() {
     let table = String::from_utf8(run(&args).stdout).unwrap();
     assert!(table.contains("not in force closure"), "{table}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// tension policies (any cable set)
+
+#[test]
+fn arm_takes_a_tension_policy() {
+    let fx = Fixture::new();
+    let q = list(&E4_Q);
+    let base = ["arm", "--robot", fx.path(), "--q", &q, "--wrench", "0,5,0,0,0,0", "--json"];
+    let levels = json(&base);
+    assert_eq!(levels["policy"], "levels");
+    assert_eq!(levels["force_closure"], true);
+    assert_eq!(levels["null_space_dimension"], 5);
+    assert!(levels["policy_objective"].is_null());
+    let total = |doc: &Value| {
+        doc["tensions"].as_array().unwrap().iter().map(|f| f.as_f64().unwrap()).sum::<f64>()
+    };
+    for (policy, objective_of) in [
+        ("least-total", total as fn(&Value) -> f64),
+        ("least-norm", |doc: &Value| {
+            doc["tensions"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|f| f.as_f64().unwrap().powi(2))
+                .sum::<f64>()
+                .sqrt()
+        }),
+        ("safest", |doc: &Value| {
+            doc["tensions"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|f| f.as_f64().unwrap())
+                .map(|f| (f - 20.0).min(600.0 - f))
+                .fold(f64::INFINITY, f64::min)
+        }),
+    ] {
+        let doc = json(&[&base[..], &["--policy", policy]].concat());
+        assert_eq!(doc["policy"], policy);
+        assert!(doc["levels"].is_null() && doc["intervals"].as_array().unwrap().is_empty());
+        let objective = doc["policy_objective"].as_f64().unwrap();
+        assert!(
+            (objective - objective_of(&doc)).abs() <= 1e-9 * objective.abs().max(1.0),
+            "{policy}: {objective}"
+        );
+        for f in doc["tensions"].as_array().unwrap() {
+            let f = f.as_f64().unwrap();
+            assert!((20.0..=600.0).contains(&f), "{policy}: {f}");
+        }
+    }
+    // Decoupled: each joint's least-total end is its level 0, so the LP's total is the levels'.
+    let lp = json(&[&base[..], &["--policy", "least-total"]].concat());
+    assert!(
+        (total(&lp) - total(&levels)).abs() <= 1e-9 * total(&levels),
+        "{} vs {}",
+        total(&lp),
+        total(&levels)
+    );
+    // The table says which policy chose the tensions, and lists the cables.
+    let args =
+        ["arm", "--robot", fx.path(), "--q", &q, "--wrench", "0,5,0,0,0,0", "--policy", "safest"];
+    let table = String::from_utf8(run(&args).stdout).unwrap();
+    assert!(table.contains("tensions by the policy safest"), "{table}");
+    assert!(table.contains("force closure: yes"), "{table}");
+    // --levels and --policy exclude each other: a usage error, exit 2.
+    let out = run(&[&args[..], &["--levels", "0,0,0,0,0"]].concat());
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn an_infeasible_load_under_a_policy_names_the_joint_and_the_motion() {
+    let fx = Fixture::new();
+    let q = list(&E4_Q);
+    assert_fails(
+        &[
+            "arm",
+            "--robot",
+            fx.path(),
+            "--q",
+            &q,
+            "--wrench",
+            "0,400,0,0,0,0",
+            "--policy",
+            "least-norm",
+        ],
+        1,
+        &[
+            "infeasible load",
+            "no tensions within the limits balance the load at joint",
+            "along the joint motion",
+            "at f_max",
+        ],
+    );
+}

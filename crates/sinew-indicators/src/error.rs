@@ -27,7 +27,7 @@ pub enum IndicatorError {
     /// The joint does not have exactly three cables of its own, consecutive in the routing:
     /// the single-joint model (eq. 22–23) cannot take it.
     #[error(
-        "joint {} has {cables} cables of its own; the single-joint model needs exactly three, consecutive in the routing",
+        "joint {} has {cables} cables of its own; the single-joint model needs exactly three, consecutive in the routing, with the common tension limits (any cable set: `sinew arm --policy`)",
         .joint + 1
     )]
     NotThreeCables {
@@ -35,6 +35,17 @@ pub enum IndicatorError {
         joint: usize,
         /// How many cables drive it.
         cables: usize,
+    },
+    /// The single-joint model (eq. 20–23) is for the universal joints of a universal arm.
+    #[error(
+        "joint {} has {dofs} revolute joint(s); the single-joint model needs an arm of universal joints (any arm: `sinew arm --policy`)",
+        .joint + 1
+    )]
+    NotUniversal {
+        /// The joint (0-based).
+        joint: usize,
+        /// Its revolute joints.
+        dofs: usize,
     },
     /// A stiffness matrix with a NaN or infinite entry.
     #[error("{what} has a non-finite entry")]

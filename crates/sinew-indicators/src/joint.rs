@@ -118,13 +118,25 @@ impl JointProbe {
         routing: &Routing,
         joint: usize,
     ) -> Result<JointProbe, IndicatorError> {
-        let joints = robot.dof() / 2;
+        let joints = robot.joint_count();
         if joint >= joints {
             return Err(IndicatorError::NoSuchJoint { joint, joints });
         }
+        let groups = robot.joint_groups();
+        if !robot.is_universal() {
+            // Name the joint asked for when it is the one at fault, else the first that is.
+            let j = if groups[joint].len() == 2 {
+                groups.iter().position(|g| g.len() != 2).unwrap_or(joint)
+            } else {
+                joint
+            };
+            return Err(IndicatorError::NotUniversal { joint: j, dofs: groups[j].len() });
+        }
         let own = routing.cables_of_joint(joint);
         let first_cable = own.start;
-        if own.len() != 3 {
+        let common = routing.tension_limits();
+        let own_limits = routing.cable_limits().get(own.clone()).unwrap_or(&[]);
+        if own.len() != 3 || own_limits.iter().any(|l| *l != common) {
             return Err(IndicatorError::NotThreeCables { joint, cables: own.len() });
         }
         let [f_min, f_max] = routing.tension_limits();

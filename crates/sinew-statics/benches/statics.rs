@@ -1,5 +1,7 @@
-//! `cargo bench -p sinew-statics`: the closed-form tension interval of one joint
-//! (target ≤ 200 ns on the 2-core CI machine).
+//! `cargo bench -p sinew-statics`: the closed-form tension interval of one joint (target
+//! ≤ 200 ns on the 2-core CI machine), and the general path on cdhrm5 (15 cables, 10 DOF) at
+//! the E4 pose and load: the equilibrium set (SVD of J_c) and each policy's distribution
+//! (target ≤ 100 µs each, set included).
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use std::hint::black_box;
@@ -23,5 +25,49 @@ fn bench_interval(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench_interval);
+fn bench_policies(c: &mut Criterion) {
+    use nalgebra::Vector6;
+    use sinew_robot::RobotData;
+    use sinew_routing::{Order, PatternModel, RoutingData, compute_cable_geometry};
+    use sinew_statics::{ArmStatics, TensionChoice, TensionPolicy};
+    use sinew_testkit::cdhrm5;
+
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let statics = ArmStatics::new(&routing);
+        let mut rdata = RobotData::new(&robot);
+        let mut geometry = RoutingData::new(&routing);
+        let mut data = statics.data(&robot);
+        let q = cdhrm5::LOADED_POSE;
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        compute_cable_geometry(&routing, &robot, &mut rdata, &mut geometry, &q, Order::Jacobian)
+            .unwrap();
+        statics.solve(&robot, &mut rdata, &geometry, &mut data, &f0, &[0.0; 5]).unwrap();
+        let name = match model {
+            PatternModel::Decoupled => "decoupled",
+            PatternModel::Routed => "routed",
+        };
+        c.bench_function(&format!("equilibrium set, cdhrm5 {name}"), |b| {
+            b.iter(|| statics.equilibrium_set(black_box(&geometry), &data).unwrap())
+        });
+        for policy in TensionPolicy::ALL {
+            c.bench_function(&format!("policy {}, cdhrm5 {name}", policy.name()), |b| {
+                b.iter(|| {
+                    statics
+                        .solve_with(
+                            &robot,
+                            &mut rdata,
+                            &geometry,
+                            &mut data,
+                            black_box(&f0),
+                            TensionChoice::Policy(policy),
+                        )
+                        .unwrap()
+                })
+            });
+        }
+    }
+}
+
+criterion_group!(benches, bench_interval, bench_policies);
 criterion_main!(benches);

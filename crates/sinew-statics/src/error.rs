@@ -313,7 +313,7 @@ impl std::fmt::Display for NoEquilibrium {
             NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } => {
                 write!(
                     f,
-                    "no tensions within the limits balance the load at {joints}: along the joint motion [{}] the load needs {} N m from the cables, who give only [{}, {}] N m within their limits",
+                    "no tensions within the limits balance the load at {joints}: along the joint motion [{}] the load needs {} N m from the cables, which give only [{}, {}] N m within their limits",
                     vector(direction),
                     Compact(*needed),
                     Compact(range[0]),

@@ -295,6 +295,20 @@ impl ArmStiffness {
         self.compliance(data)
     }
 
+    /// The equilibrium set `f = f_p + N λ` (with every cable's limits) at the last evaluated
+    /// configuration and load: every tension vector that balances it
+    /// ([`sinew_statics::EquilibriumSet`]). Allocates (an SVD of `J_c`).
+    ///
+    /// # Errors
+    /// [`StiffnessError::WorkspaceMismatch`]; those of [`sinew_statics::EquilibriumSet::new`].
+    pub fn equilibrium_set(
+        &self,
+        data: &ArmStiffnessData,
+    ) -> Result<sinew_statics::EquilibriumSet, StiffnessError> {
+        self.check(data)?;
+        Ok(self.statics.equilibrium_set(&data.cables, &data.statics)?)
+    }
+
     /// `∂K_q/∂λ_i` at the last evaluated configuration (dof × dof, into `out`): `K_q` is affine
     /// in each joint's null-space coordinate `λ_i`, so a sweep over joint `i`'s tension levels
     /// is `K_q + (λ − λ_now) · slope`, with no new geometry. Exact in both models (routed:

@@ -33,7 +33,7 @@ pub struct RoutingView<'a> {
 pub struct CableView<'a> {
     /// Its name.
     pub name: &'a str,
-    /// The universal joint it drives, 0-based.
+    /// The joint it drives, 0-based.
     pub joint: usize,
     /// Its holes, base first.
     pub holes: Vec<HoleView<'a>>,
@@ -65,7 +65,6 @@ impl Routing {
     /// The expanded routing as plain data: every cable's holes as link + point in the link
     /// frame, its joint, lengths, stiffness and limits. Serialises as [`Routing`] does.
     pub fn view(&self) -> RoutingView<'_> {
-        let [f_min, f_max] = self.tension_limits;
         RoutingView {
             robot: &self.robot,
             source: &self.source,
@@ -91,8 +90,8 @@ impl Routing {
                     routed_length: c.routed_length,
                     elastic_length: c.elastic_length,
                     stiffness: c.stiffness,
-                    f_min,
-                    f_max,
+                    f_min: c.tension_limits[0],
+                    f_max: c.tension_limits[1],
                 })
                 .collect(),
         }
