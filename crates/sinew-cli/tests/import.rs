@@ -110,3 +110,67 @@ fn a_failed_import_writes_nothing() {
     assert!(stderr.contains(&format!("{bad_s}:2:3: <links> holds no <link_rigid>")), "{stderr}");
     assert_eq!(entries(tmp.path()), [bad]);
 }
+
+/// Every command on imported folders: the all-universal model (three cables per joint: levels
+/// and policies, joint, sweep) and the mixed one (R_X, R_Y, R_Z beside universal joints, three
+/// cables for nine DOF: the arm answers with a typed infeasibility naming the joints, exit 1).
+#[test]
+fn every_command_runs_on_imported_folders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("arm");
+    assert!(import(&out, &[]).status.success());
+    let dir = out.to_str().unwrap();
+    for args in [
+        vec!["routing", "--robot", dir],
+        vec!["arm", "--robot", dir, "--q", "0.1,0.1,0.1,0.1", "--no-gravity"],
+        vec![
+            "arm",
+            "--robot",
+            dir,
+            "--q",
+            "0.1,0.1,0.1,0.1",
+            "--no-gravity",
+            "--policy",
+            "least-norm",
+        ],
+        vec!["joint", "--robot", dir, "--joint", "1", "--q", "0.1,0.1", "--torque", "0.1,0.1"],
+        vec!["sweep", "--robot", dir, "--joint", "1", "--torque", "0.1,0.1", "--grid", "3"],
+    ] {
+        // An answer: the result (exit 0), or the typed infeasibility of this synthetic model's
+        // second joint, whose cables cannot all stay above f_min at zero torque (exit 1).
+        let result = run(&args);
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        let answered = result.status.success()
+            || (result.status.code() == Some(1)
+                && stderr.starts_with("sinew: infeasible load: ")
+                && stderr.contains("joint 2")
+                && stderr.lines().count() == 1);
+        assert!(answered, "{args:?}: {stderr}");
+    }
+    let mixed = tmp.path().join("mixed");
+    let (bodies, cables) = (data("every_joint_bodies.xml"), data("every_joint_cables.xml"));
+    let mixed_s = mixed.display().to_string();
+    let result =
+        run(&["import", "caspr", "--bodies", &bodies, "--cables", &cables, "--out", &mixed_s]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let routing = run(&["routing", "--robot", &mixed_s, "--json"]);
+    assert!(routing.status.success(), "{}", String::from_utf8_lossy(&routing.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&routing.stdout).unwrap();
+    let joints: Vec<u64> =
+        doc["joints"].as_array().unwrap().iter().map(|j| j["joint"].as_u64().unwrap()).collect();
+    assert_eq!(joints, [0, 1, 2, 3, 3, 4, 4, 5, 5], "three revolute, then three universal joints");
+    let q = vec!["0.05"; 9].join(",");
+    let arm = run(&["arm", "--robot", &mixed_s, "--q", &q]);
+    assert_eq!(arm.status.code(), Some(1), "{}", String::from_utf8_lossy(&arm.stderr));
+    let stderr = String::from_utf8_lossy(&arm.stderr);
+    assert!(stderr.contains("no cable tensions balance the load at joints"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    // The single-joint model is for universal arms: a clear refusal, exit 2.
+    let joint =
+        run(&["joint", "--robot", &mixed_s, "--joint", "1", "--q", "0.1", "--torque", "0.1"]);
+    assert_eq!(joint.status.code(), Some(2), "{}", String::from_utf8_lossy(&joint.stderr));
+    assert!(
+        String::from_utf8_lossy(&joint.stderr)
+            .contains("single-joint model needs an arm of universal joints")
+    );
+}

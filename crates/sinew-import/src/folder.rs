@@ -137,14 +137,6 @@ pub(crate) fn build(model: &CasprModel, options: &ImportOptions) -> Result<Robot
 
     let dof: usize = model.links.iter().map(|l| l.joint.dof()).sum();
     let universal_joints = model.links.iter().filter(|l| l.joint.dof() == 2).count();
-    if universal_joints != model.links.len() {
-        warnings.push(format!(
-            "{} of {} links have a 1-DOF revolute joint ({} DOF): sinew-routing today loads routings of all-universal robots (even DOF) only",
-            model.links.len() - universal_joints,
-            model.links.len(),
-            dof
-        ));
-    }
 
     let urdf_file = format!("{name}.urdf");
     let urdf = write_urdf(model, &name, &names, &tip);

@@ -44,6 +44,50 @@
 //! ]
 //! ```
 //!
+//! The explicit form takes any cable set: any number of cables per joint, cables that cross
+//! several joints (shared), and robots whose joints are 1-DOF revolute joints beside 2-DOF
+//! universal ones ([`sinew_robot::Robot::joint_groups`]). The pattern form needs an arm of
+//! universal joints. Four cables on one universal joint (two antagonistic pairs, 90° apart;
+//! the tensions then have a 2-dimensional equilibrium set per joint, chosen by a policy):
+//!
+//! ```toml
+//! [[cable]]
+//! name = "j1a"
+//! holes = [{ link = "base_link", point = [0.02, 0.0, 0.0] }, { link = "link1", point = [0.02, 0.0, 0.0] }]
+//! [[cable]]
+//! name = "j1b"
+//! holes = [{ link = "base_link", point = [0.0, 0.02, 0.0] }, { link = "link1", point = [0.0, 0.02, 0.0] }]
+//! [[cable]]
+//! name = "j1c"
+//! holes = [{ link = "base_link", point = [-0.02, 0.0, 0.0] }, { link = "link1", point = [-0.02, 0.0, 0.0] }]
+//! [[cable]]
+//! name = "j1d"
+//! holes = [{ link = "base_link", point = [0.0, -0.02, 0.0] }, { link = "link1", point = [0.0, -0.02, 0.0] }]
+//! ```
+//!
+//! A revolute joint (`link1`, about x) followed by a universal joint (`link2`): two cables
+//! drive the revolute joint, and a shared cable runs through `link1`'s discs to anchor on
+//! `link2`, so it loads both joints (its `joint` is the universal joint, which moves its
+//! anchor):
+//!
+//! ```toml
+//! [[cable]]
+//! name = "r_up"
+//! holes = [{ link = "base_link", point = [0.0, 0.02, 0.0] }, { link = "link1", point = [0.0, 0.02, 0.0] }]
+//! [[cable]]
+//! name = "r_down"
+//! holes = [{ link = "base_link", point = [0.0, -0.02, 0.0] }, { link = "link1", point = [0.0, -0.02, 0.0] }]
+//! [[cable]]
+//! name = "shared"
+//! tension_limits = [10.0, 300.0]
+//! holes = [
+//!   { link = "base_link", point = [0.015, 0.015, 0.0] },
+//!   { link = "link1", point = [0.015, 0.015, 0.0] },
+//!   { link = "link1_distal", point = [0.015, 0.015, 0.0] },
+//!   { link = "link2", point = [0.015, 0.015, 0.0] },
+//! ]
+//! ```
+//!
 //! The elastic length of a cable is `l_c = free_length + L_c(Q = 0)` (the free length from the
 //! actuator plus the routed length), its stiffness `k_c = E·A / l_c` (eq. 13).
 
