@@ -31,6 +31,8 @@ struct ArmOut {
     /// The policy's objective: Σ f (N), |f| (N) or the least distance to a limit (N); null
     /// with levels.
     policy_objective: Option<f64>,
+    /// The convex solver's interior-point iterations (null with levels).
+    policy_iterations: Option<u32>,
     /// Whether some strictly positive tension vector balances no load (every torque reachable
     /// with high enough tensions): a property of the pose and routing, reported.
     force_closure: bool,
@@ -213,6 +215,7 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         policy: if levels.is_some() { "levels" } else { policy.name() },
         levels,
         policy_objective,
+        policy_iterations: data.statics.distribution.as_ref().map(|d| d.iterations),
         force_closure,
         null_space_dimension: set.dimension(),
         cables,

@@ -159,7 +159,7 @@ fn every_command_runs_on_imported_folders() {
     let joints: Vec<u64> =
         doc["joints"].as_array().unwrap().iter().map(|j| j["joint"].as_u64().unwrap()).collect();
     assert_eq!(joints, [0, 1, 2, 3, 3, 4, 4, 5, 5], "three revolute, then three universal joints");
-    let q = vec!["0.05"; 9].join(",");
+    let q = ["0.05"; 9].join(",");
     let arm = run(&["arm", "--robot", &mixed_s, "--q", &q]);
     assert_eq!(arm.status.code(), Some(1), "{}", String::from_utf8_lossy(&arm.stderr));
     let stderr = String::from_utf8_lossy(&arm.stderr);

@@ -21,6 +21,12 @@
 //! another joint, `N` has one column per joint and the polytope is the box of the per-joint
 //! intervals of [`crate::tension_interval`].
 //!
+//! The SVD is taken block by block: the DOFs linked by the cables that move them (non-zero
+//! entries of `J_c`) fall into independent blocks — one per joint in the decoupled model, one
+//! for the whole arm when every cable runs from the base — and `N` is block diagonal over them
+//! (one column per joint with three cables on each universal joint of a decoupled arm), which
+//! keeps the policies' programs sparse.
+//!
 //! Force closure — some strictly positive `f` in `null(J_cᵀ)`, so that any torque can be held
 //! with high enough tensions — is a property of the pose and the routing
 //! ([`EquilibriumSet::force_closure`]), not a condition of feasibility.
@@ -47,11 +53,67 @@ pub struct EquilibriumSet {
     null: Mat<f64>,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    /// `U_r` (m × r), `Σ_r` (r), `V_r` (dof × r): `J_c⁺ = V_r Σ_r⁻¹ U_rᵀ` maps a cable vector
-    /// in the range of `J_c` back to joint space (for certificates).
+    /// The independent blocks of `J_c` and their SVDs (for `J_c⁺`).
+    blocks: Vec<Block>,
+    dof: usize,
+}
+
+/// An independent block of `J_c`: cables that move only these DOFs, DOFs that only these
+/// cables move. `U_r` (cables × r), `Σ_r` (r), `V_r` (DOFs × r): `J_c⁺ = V_r Σ_r⁻¹ U_rᵀ` on it.
+#[derive(Debug, Clone, PartialEq)]
+struct Block {
+    cables: Vec<usize>,
+    dofs: Vec<usize>,
     u_range: Mat<f64>,
     singular: Vec<f64>,
     v_range: Mat<f64>,
+}
+
+/// The independent blocks of `J_c` (m × dof): the connected components of the DOFs linked by
+/// the cables that move them (a non-zero `J_c[c, d]`), each with its cables (base first). A
+/// cable that moves no DOF is a block of its own with no DOFs; so is a DOF no cable moves.
+fn independent_blocks(jacobian: MatRef<'_, f64>) -> Vec<(Vec<usize>, Vec<usize>)> {
+    let (m, dof) = (jacobian.nrows(), jacobian.ncols());
+    let mut parent: Vec<usize> = (0..dof).collect();
+    fn root(parent: &mut [usize], mut d: usize) -> usize {
+        while parent[d] != d {
+            parent[d] = parent[parent[d]];
+            d = parent[d];
+        }
+        d
+    }
+    let first: Vec<Option<usize>> =
+        (0..m).map(|c| (0..dof).find(|&d| jacobian[(c, d)] != 0.0)).collect();
+    for (c, first) in first.iter().enumerate() {
+        let Some(a) = *first else { continue };
+        for d in a + 1..dof {
+            if jacobian[(c, d)] != 0.0 {
+                let (ra, rd) = (root(&mut parent, a), root(&mut parent, d));
+                parent[rd] = ra;
+            }
+        }
+    }
+    let mut blocks: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::new();
+    for d in 0..dof {
+        let r = root(&mut parent, d);
+        match blocks.iter_mut().find(|b| b.0 == r) {
+            Some(b) => b.2.push(d),
+            None => blocks.push((r, Vec::new(), vec![d])),
+        }
+    }
+    let mut lone = Vec::new();
+    for (c, first) in first.iter().enumerate() {
+        match first {
+            Some(d) => {
+                let r = root(&mut parent, *d);
+                if let Some(b) = blocks.iter_mut().find(|b| b.0 == r) {
+                    b.1.push(c);
+                }
+            }
+            None => lone.push((vec![c], Vec::new())),
+        }
+    }
+    blocks.into_iter().map(|(_, cables, dofs)| (cables, dofs)).chain(lone).collect()
 }
 
 impl EquilibriumSet {
@@ -83,29 +145,54 @@ impl EquilibriumSet {
         if !finite {
             return Err(StaticsError::NonFiniteInput { what: "cable Jacobian or T0" });
         }
-        let svd = jacobian.svd().map_err(|_| StaticsError::Numerical { what: "SVD of J_c" })?;
-        let s = svd.S().column_vector();
-        let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
-        let rank = (0..s.nrows()).filter(|&i| s[i] > SET_RANK_TOLERANCE * largest).count();
-        let u = svd.U();
-        let v = svd.V();
-        let u_range = u.subcols(0, rank).to_owned();
-        let v_range = v.subcols(0, rank).to_owned();
-        let singular: Vec<f64> = (0..rank).map(|i| s[i]).collect();
-        // f_p = −U_r Σ_r⁻¹ V_rᵀ T0.
-        let y: Vec<f64> = (0..rank)
-            .map(|i| (0..dof).map(|d| v_range[(d, i)] * t0[d]).sum::<f64>() / singular[i])
-            .collect();
-        let particular: Vec<f64> =
-            (0..m).map(|c| -(0..rank).map(|i| u_range[(c, i)] * y[i]).sum::<f64>()).collect();
+        let mut particular = vec![0.0; m];
+        let mut null_columns: Vec<Vec<(usize, f64)>> = Vec::new();
+        let mut blocks = Vec::new();
+        for (cables, dofs) in independent_blocks(jacobian) {
+            if cables.is_empty() {
+                continue; // DOFs no cable moves: the residual check below names them.
+            }
+            let sub = Mat::from_fn(cables.len(), dofs.len(), |r, c| jacobian[(cables[r], dofs[c])]);
+            let svd = sub.svd().map_err(|_| StaticsError::Numerical { what: "SVD of J_c" })?;
+            let s = svd.S().column_vector();
+            let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
+            let rank = (0..s.nrows()).filter(|&i| s[i] > SET_RANK_TOLERANCE * largest).count();
+            let (u, v) = (svd.U(), svd.V());
+            let singular: Vec<f64> = (0..rank).map(|i| s[i]).collect();
+            // f_p = −U_r Σ_r⁻¹ V_rᵀ T0 on the block.
+            let y: Vec<f64> = (0..rank)
+                .map(|i| {
+                    (0..dofs.len()).map(|d| v[(d, i)] * t0[dofs[d]]).sum::<f64>() / singular[i]
+                })
+                .collect();
+            for (r, &c) in cables.iter().enumerate() {
+                particular[c] = -(0..rank).map(|i| u[(r, i)] * y[i]).sum::<f64>();
+            }
+            for i in rank..cables.len() {
+                null_columns
+                    .push(cables.iter().enumerate().map(|(r, &c)| (c, u[(r, i)])).collect());
+            }
+            blocks.push(Block {
+                u_range: u.subcols(0, rank).to_owned(),
+                v_range: v.subcols(0, rank).to_owned(),
+                singular,
+                cables,
+                dofs,
+            });
+        }
+        let mut null = Mat::zeros(m, null_columns.len());
+        for (i, column) in null_columns.iter().enumerate() {
+            for &(c, value) in column {
+                null[(c, i)] = value;
+            }
+        }
         let set = EquilibriumSet {
-            null: u.subcols(rank, m - rank).to_owned(),
+            null,
             lower: limits.iter().map(|l| l[0]).collect(),
             upper: limits.iter().map(|l| l[1]).collect(),
             particular,
-            u_range,
-            singular,
-            v_range,
+            blocks,
+            dof,
         };
         // The residual T0 + J_cᵀ f_p: what the cables cannot produce.
         let residual: Vec<f64> = (0..dof)
@@ -192,16 +279,24 @@ impl EquilibriumSet {
     /// `J_c⁺ w`: the joint motion `δq` whose cable length changes `J_c δq` are the part of `w`
     /// (m) in the range of `J_c`.
     pub fn joint_motion(&self, w: &[f64]) -> Vec<f64> {
-        let dof = self.v_range.nrows();
-        let y: Vec<f64> = (0..self.singular.len())
-            .map(|i| {
-                (0..self.cable_count().min(w.len()))
-                    .map(|c| self.u_range[(c, i)] * w[c])
-                    .sum::<f64>()
-                    / self.singular[i]
-            })
-            .collect();
-        (0..dof).map(|d| (0..y.len()).map(|i| self.v_range[(d, i)] * y[i]).sum()).collect()
+        let mut motion = vec![0.0; self.dof];
+        for b in &self.blocks {
+            let y: Vec<f64> = (0..b.singular.len())
+                .map(|i| {
+                    let dot: f64 = b
+                        .cables
+                        .iter()
+                        .enumerate()
+                        .map(|(r, &c)| b.u_range[(r, i)] * w.get(c).copied().unwrap_or(0.0))
+                        .sum();
+                    dot / b.singular[i]
+                })
+                .collect();
+            for (k, &d) in b.dofs.iter().enumerate() {
+                motion[d] = (0..y.len()).map(|i| b.v_range[(k, i)] * y[i]).sum();
+            }
+        }
+        motion
     }
 
     /// Whether the cables are in force closure at this pose: some strictly positive tension

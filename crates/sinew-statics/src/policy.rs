@@ -235,7 +235,7 @@ impl Program {
         };
         let a = csc(self.rows(), n, |r, c| self.g[r * n + c]);
         let cones = [SupportedConeT::NonnegativeConeT(self.rows())];
-        let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
+        let settings = settings();
         let mut solver = DefaultSolver::new(&p_matrix, &self.q, &a, &self.h, &cones, settings)
             .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
         solver.solve();
@@ -293,6 +293,12 @@ impl Program {
             .collect();
         if feasible(&polished) { polished } else { x }
     }
+}
+
+/// The solver's settings: quiet, no equilibration (the rows are unit-scaled cable tensions
+/// already), otherwise clarabel's defaults.
+fn settings() -> DefaultSettings<f64> {
+    DefaultSettings { verbose: false, equilibrate_enable: false, ..DefaultSettings::default() }
 }
 
 /// Dense to CSC, skipping exact zeros.
@@ -384,7 +390,7 @@ pub(crate) fn force_closure(set: &EquilibriumSet) -> Result<bool, StaticsError> 
     b[m..].fill(1.0);
     let mut q = vec![0.0; n];
     q[k] = -1.0;
-    let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
+    let settings = settings();
     let cones = [SupportedConeT::NonnegativeConeT(rows)];
     let mut solver = DefaultSolver::new(&CscMatrix::zeros((n, n)), &q, &a, &b, &cones, settings)
         .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
