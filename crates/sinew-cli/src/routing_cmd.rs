@@ -30,8 +30,11 @@ struct JointOut<'a> {
     /// Index in Q, 0-based.
     index: usize,
     name: &'a str,
-    /// The universal joint it belongs to, 0-based.
+    /// The arm joint it belongs to (a universal joint or a 1-DOF joint), 0-based.
     universal_joint: usize,
+    /// Its place in that joint, from 1; 0 for a 1-DOF joint (the table's `q` names).
+    #[serde(skip)]
+    position: usize,
     /// Unit axis in the joint frame.
     axis: [f64; 3],
     lower: f64,
@@ -62,7 +65,13 @@ fn document(loaded: &Loaded) -> RoutingOut<'_> {
             .map(|(index, j)| JointOut {
                 index,
                 name: &j.name,
-                universal_joint: index / 2,
+                // The arm joint (robot.joint_groups(): a universal pair or a 1-DOF joint), not
+                // index / 2: a chain of 1-DOF joints is not one of pairs.
+                universal_joint: robot.joint_of_dof(index).unwrap_or(index),
+                position: robot.joint_groups().iter().find(|g| g.contains(&index)).map_or(
+                    0,
+                    |g| if g.len() == 1 { 0 } else { index - g.start + 1 },
+                ),
                 axis: [j.axis.x, j.axis.y, j.axis.z],
                 lower: j.lower,
                 upper: j.upper,
@@ -95,11 +104,15 @@ fn render(out: &RoutingOut<'_>) -> String {
         out.routing.tension_limits[0],
         out.routing.tension_limits[1]
     ));
-    s.push_str("Revolute joints, base first (universal joints numbered from 1), limits in rad:\n");
+    s.push_str("Revolute joints, base first (arm joints numbered from 1: universal or 1-DOF), limits in rad:\n");
     let mut joints = Table::new(&["q", "name", "joint", "axis", "lower", "upper"]).left(&[1]);
     for j in &out.joints {
         joints.row(vec![
-            format!("q{}{}", j.universal_joint + 1, j.index % 2 + 1),
+            if j.position == 0 {
+                format!("q{}", j.universal_joint + 1)
+            } else {
+                format!("q{}{}", j.universal_joint + 1, j.position)
+            },
             j.name.to_owned(),
             format!("{}", j.universal_joint + 1),
             Fmt::Fixed(3).list(&j.axis),
