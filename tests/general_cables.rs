@@ -251,7 +251,8 @@ fn sub_set(
     let t0: Vec<f64> = data.t0[dofs.clone()].to_vec();
     let sub = Mat::from_fn(cables.len(), dofs.len(), |r, d| j[(cables[r], dofs.start + d)]);
     let limits: Vec<[f64; 2]> = cables.iter().map(|&c| statics.cable_limits()[c]).collect();
-    EquilibriumSet::new(sub.as_ref(), &t0, &limits, &[0..dofs.len()]).unwrap()
+    let one_joint = 0..dofs.len();
+    EquilibriumSet::new(sub.as_ref(), &t0, &limits, std::slice::from_ref(&one_joint)).unwrap()
 }
 
 /// The policy's objective at tensions `f` (minimised: the least distance to a limit enters
@@ -345,7 +346,9 @@ fn every_policy_is_optimal_against_a_brute_force_scan_of_its_null_space() {
         let fine = if k == 1 { 200_001 } else { 1201 };
         for policy in TensionPolicy::ALL {
             let mut f = vec![0.0; set.cable_count()];
-            let answer = distribute_with_policy(set, policy, &[0..1], &[], &mut f).unwrap();
+            let answer =
+                distribute_with_policy(set, policy, std::slice::from_ref(&(0..1)), &[], &mut f)
+                    .unwrap();
             let mine = objective(policy, set, &f);
             let bound = norm(set.upper()) + norm(set.particular());
             let (_, lo, hi, _) = scan(set, policy, &vec![-bound; k], &vec![bound; k], 401);

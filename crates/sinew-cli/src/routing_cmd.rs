@@ -68,10 +68,11 @@ fn document(loaded: &Loaded) -> RoutingOut<'_> {
                 // The arm joint (robot.joint_groups(): a universal pair or a 1-DOF joint), not
                 // index / 2: a chain of 1-DOF joints is not one of pairs.
                 universal_joint: robot.joint_of_dof(index).unwrap_or(index),
-                position: robot.joint_groups().iter().find(|g| g.contains(&index)).map_or(
-                    0,
-                    |g| if g.len() == 1 { 0 } else { index - g.start + 1 },
-                ),
+                position: robot
+                    .joint_groups()
+                    .iter()
+                    .find(|g| g.contains(&index))
+                    .map_or(0, |g| if g.len() == 1 { 0 } else { index - g.start + 1 }),
                 axis: [j.axis.x, j.axis.y, j.axis.z],
                 lower: j.lower,
                 upper: j.upper,

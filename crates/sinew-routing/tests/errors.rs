@@ -336,7 +336,7 @@ fn pattern_needs_universal_joints() {
     let settings =
         ChainSettings { tip_link: "tip".to_owned(), gravity: nalgebra::Vector3::zeros() };
     let robot = Robot::from_urdf_str(urdf, "one.urdf", &settings).unwrap();
-    assert_eq!(robot.joint_groups(), &[0..1]);
+    assert_eq!(robot.joint_groups(), std::slice::from_ref(&(0..1)));
     let text = pattern(r#"["base"]"#, r#"["tip"]"#);
     let err = Routing::from_toml_str(&text, FILE, &robot).unwrap_err();
     assert!(matches!(err, RoutingError::NotUniversal { dof: 1, .. }), "{err:?}");

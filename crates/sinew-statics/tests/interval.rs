@@ -122,8 +122,7 @@ fn lost_force_closure_is_reported_not_refused() {
     }
     // Each end has one cable on a limit: cable 1 or 2 on f_min or f_max.
     let (low, high) = interval.ends();
-    let on_limit =
-        |f: nalgebra::Vector3<f64>| f.iter().any(|&v| v == LIMITS.f_min || v == LIMITS.f_max);
+    let on_limit = |f: Vector3<f64>| f.iter().any(|&v| v == LIMITS.f_min || v == LIMITS.f_max);
     assert!(on_limit(low) && on_limit(high), "{low:?} {high:?}");
     // Cable 3 must keep 100 N, whatever λ: a torque needing 1000 N is refused, naming it.
     let err = tension_interval(0, &jacobian, &Vector2::new(-4.0, 20.0), LIMITS).unwrap_err();
