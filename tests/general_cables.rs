@@ -392,6 +392,16 @@ fn every_policy_is_optimal_against_a_brute_force_scan_of_its_null_space() {
     }
 }
 
+/// `K_q`'s and `C_x`'s differences relative to `closed` (`C_x` only when the arm is stable).
+fn k_q_and_c_x_diff(
+    general: &ArmStiffnessData,
+    closed: &ArmStiffnessData,
+    stable: bool,
+) -> (f64, f64) {
+    let c = if stable { rel_diff(general.compliance(), closed.compliance()) } else { 0.0 };
+    (rel_diff(general.k_q(), closed.k_q()), c)
+}
+
 #[test]
 fn the_general_path_agrees_with_the_closed_form_on_cdhrm5() {
     let load = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
@@ -438,12 +448,7 @@ fn the_general_path_agrees_with_the_closed_form_on_cdhrm5() {
                         tension_diff <= 1e-12,
                         "decoupled: tensions differ by {tension_diff:e}"
                     );
-                    let k = rel_diff(general.k_q(), closed.k_q());
-                    let c = if is_stable {
-                        rel_diff(general.compliance(), closed.compliance())
-                    } else {
-                        0.0
-                    };
+                    let (k, c) = k_q_and_c_x_diff(&general, &closed, is_stable);
                     println!("  K_q differ by {k:.2e}, C_x by {c:.2e} (stable: {is_stable})");
                     assert!(k <= 1e-12 && c <= 1e-12, "decoupled: K_q {k:e}, C_x {c:e}");
                 }
@@ -463,12 +468,7 @@ fn the_general_path_agrees_with_the_closed_form_on_cdhrm5() {
                         Err(StiffnessError::Unstable { .. }) => assert!(!is_stable),
                         Err(e) => panic!("{q:?}: {e}"),
                     }
-                    let k = rel_diff(general.k_q(), closed.k_q());
-                    let c = if is_stable {
-                        rel_diff(general.compliance(), closed.compliance())
-                    } else {
-                        0.0
-                    };
+                    let (k, c) = k_q_and_c_x_diff(&general, &closed, is_stable);
                     println!("  given levels-0 tensions: K_q differ by {k:.2e}, C_x by {c:.2e}");
                     assert!(k <= 1e-12 && c <= 1e-12, "routed: K_q {k:e}, C_x {c:e}");
                 }
