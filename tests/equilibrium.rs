@@ -19,14 +19,15 @@
 //! and `R(Q) = 0` at equilibrium (the library's `−J_cᵀ f − T_g − J_xᵀ(F0 − δw)`, eq. 5–6, but
 //! not computed that way). A base-fixed moment has no potential, so its part enters through the
 //! tip rotation: `ω_i = log(R_tip(Q + h e_i) R_tip(Q − h e_i)ᵀ) / 2h`. Every derivative is an
-//! eighth-order central difference of values ([`STENCIL`], [`H_VALUES`]); Newton's matrix is a
-//! central difference of `R` ([`H_NEWTON`]), computed once at `Q0` (a chord method: it decides
+//! eighth-order central difference of values (`sinew_testkit::newton`'s `STENCIL`, `H_VALUES`); Newton's matrix is a
+//! central difference of `R` (`H_NEWTON`), computed once at `Q0` (a chord method: it decides
 //! how fast Newton converges, never where to). The sign of the load term is the library's
 //! convention (spec §5): `F0` is what the end-effector exerts, so the environment's force on it
 //! is `−(F0 − δw)`, whose potential is `+(F0 − δw) · p`.
 //!
 //! # What it depends on
-//! From the library, values only, all in [`Values::at`] and [`linearise`]: the cable lengths
+//! From the library, values only, all in `Values::at` (`sinew_testkit::newton`, with the model
+//! below) and [`linearise`]: the cable lengths
 //! `L_c(Q)` (`compute_cable_geometry` at `Order::Lengths`), the body poses and the tip pose
 //! (forward kinematics), the body masses and centres of mass, the gravity vector, `k_c`
 //! (`Routing::cable_stiffness`), and at the reference the tensions `f0`, `C_x`, `K_x` and the
@@ -59,33 +60,19 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
-use faer::linalg::solvers::Solve;
-use nalgebra::{IsometryMatrix3, Point3, Rotation3, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sinew::robot::{Robot, RobotData};
-use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew::robot::Robot;
+use sinew::routing::Routing;
 use sinew::statics::StaticsError;
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use sinew::paper::E4_Q;
+use sinew_testkit::newton::Elastic;
 
 const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
 
-/// Eighth-order central differences: `f'(x) ≈ Σ_m w_m (f(x + m h) − f(x − m h)) / h`.
-const STENCIL: [(f64, f64); 4] =
-    [(1.0, 4.0 / 5.0), (2.0, -1.0 / 5.0), (3.0, 4.0 / 105.0), (4.0, -1.0 / 280.0)];
-/// Step of [`STENCIL`], rad. Against the library's analytic residual (not used here) the
-/// difference is ≤ 1.5e-11 N m at E4 and three random configurations of either routing
-/// (2.5e-11 with a sixth-order stencil at 5e-3, 1e-10 with a fourth-order one at 1e-3); the
-/// round-off floor of the residual, from the cable lengths' last bits times tensions of hundreds
-/// of newtons, is ~1e-11 N m.
-const H_VALUES: f64 = 1e-2;
-/// Step of the central differences of the residual in Newton's matrix, rad.
-const H_NEWTON: f64 = 1e-5;
-/// Newton takes one more step once the residual norm is below this, N m (and then stops at
-/// the round-off floor, ~1e-11 N m).
-const NEWTON_TOLERANCE: f64 = 1e-10;
 /// Below this stability margin (N m/rad) the probes shrink with the square of the margin.
 const PROBE_MARGIN: f64 = 0.6;
 /// The probes at full size: a force (N) along each axis, a moment (N m) about each.
@@ -96,7 +83,7 @@ const PROBE_MOMENT: f64 = 1e-4;
 const SCALES: [f64; 3] = [1.0, 0.3, 0.1];
 
 // ---------------------------------------------------------------------------------------------
-// The library: every call of it is in `linearise` and `Values::at`.
+// The library: every call of it is in `linearise` and `sinew_testkit::newton::Values::at`.
 
 /// The library's linear answer at a reference equilibrium.
 struct Linear {
@@ -136,191 +123,6 @@ fn linearise(
         margin: data.stability_margin().unwrap(),
         tensions: data.tensions().to_vec(),
     })
-}
-
-/// Workspaces for the library's values at one configuration.
-struct Values<'a> {
-    robot: &'a Robot,
-    routing: &'a Routing,
-    kinematics: RobotData,
-    cables: RoutingData,
-}
-
-impl<'a> Values<'a> {
-    fn new(robot: &'a Robot, routing: &'a Routing) -> Values<'a> {
-        Values {
-            robot,
-            routing,
-            kinematics: RobotData::new(robot),
-            cables: RoutingData::new(routing),
-        }
-    }
-
-    /// The cable lengths (m), the tip pose (base frame) and the gravitational potential energy
-    /// `−Σ_b m_b g · c_b` (J) at `q`: values, no derivative.
-    fn at(&mut self, q: &[f64]) -> (&[f64], IsometryMatrix3<f64>, f64) {
-        let (robot, routing) = (self.robot, self.routing);
-        compute_cable_geometry(
-            routing,
-            robot,
-            &mut self.kinematics,
-            &mut self.cables,
-            q,
-            Order::Lengths,
-        )
-        .unwrap();
-        let g = robot.gravity();
-        let gravity_energy = -robot
-            .bodies()
-            .iter()
-            .enumerate()
-            .map(|(b, body)| {
-                let c = self.kinematics.body_pose(b).unwrap() * Point3::from(body.com);
-                body.mass * g.dot(&c.coords)
-            })
-            .sum::<f64>();
-        let tip = robot.tip_pose(&self.kinematics).unwrap();
-        (self.cables.lengths().unwrap(), tip, gravity_energy)
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// The nonlinear model, from values only.
-
-/// The elastic-cable model frozen at a reference equilibrium.
-struct Elastic<'a> {
-    values: Values<'a>,
-    /// Tensions at the reference, N.
-    f0: Vec<f64>,
-    /// Cable lengths at the reference, m.
-    l0: Vec<f64>,
-    /// Axial stiffness of each cable, N/m.
-    k: Vec<f64>,
-    /// Wrench the end-effector exerts on its environment at the reference, base frame.
-    load: Vector6<f64>,
-}
-
-impl<'a> Elastic<'a> {
-    fn new(
-        robot: &'a Robot,
-        routing: &'a Routing,
-        q0: &[f64],
-        f0: Vec<f64>,
-        load: Vector6<f64>,
-    ) -> Elastic<'a> {
-        let mut values = Values::new(robot, routing);
-        let l0 = values.at(q0).0.to_vec();
-        Elastic { values, f0, l0, k: routing.cable_stiffness().to_vec(), load }
-    }
-
-    /// `V(Q)` (with the load `F0 − δw`) and the tip's rotation.
-    fn energy(&mut self, q: &[f64], dw: &Vector6<f64>) -> (f64, Rotation3<f64>) {
-        let force = (self.load - dw).fixed_rows::<3>(0).into_owned();
-        let (lengths, tip, gravity_energy) = self.values.at(q);
-        let cables: f64 = lengths
-            .iter()
-            .enumerate()
-            .map(|(c, l)| {
-                let stretch = l - self.l0[c];
-                self.f0[c] * stretch + 0.5 * self.k[c] * stretch * stretch
-            })
-            .sum();
-        (gravity_energy + cables + force.dot(&tip.translation.vector), tip.rotation)
-    }
-
-    /// `R(Q) = −∂V/∂Q − (F0 − δw)_m · ω(Q)`, zero at equilibrium (N m).
-    fn residual(&mut self, q: &[f64], dw: &Vector6<f64>) -> Vec<f64> {
-        let moment = (self.load - dw).fixed_rows::<3>(3).into_owned();
-        let h = H_VALUES;
-        let mut qs = q.to_vec();
-        (0..q.len())
-            .map(|i| {
-                let mut at = |t: f64| {
-                    qs[i] = q[i] + t;
-                    let e = self.energy(&qs, dw);
-                    qs[i] = q[i];
-                    e
-                };
-                // f(t) = V(q + t) − V(q − t) and log(R(q + t) R(q − t)ᵀ) are odd in t; the
-                // weights below cancel their t³ and t⁵ terms: an O(h⁶) derivative.
-                let (mut dv, mut omega) = (0.0, Vector3::zeros());
-                for (m, w) in STENCIL {
-                    let (t, (vp, rp)) = (m * h, at(m * h));
-                    let (vm, rm) = at(-t);
-                    dv += w * (vp - vm) / h;
-                    omega += w * (rp * rm.inverse()).scaled_axis() / h;
-                }
-                -dv - moment.dot(&omega)
-            })
-            .collect()
-    }
-
-    /// Newton's matrix `∂R/∂Q` at `q`, by central differences of `R`.
-    fn newton_matrix(&mut self, q: &[f64]) -> Mat<f64> {
-        let n = q.len();
-        let mut jac = Mat::<f64>::zeros(n, n);
-        let mut qs = q.to_vec();
-        for i in 0..n {
-            qs[i] = q[i] + H_NEWTON;
-            let rp = self.residual(&qs, &Vector6::zeros());
-            qs[i] = q[i] - H_NEWTON;
-            let rm = self.residual(&qs, &Vector6::zeros());
-            qs[i] = q[i];
-            for j in 0..n {
-                jac[(j, i)] = (rp[j] - rm[j]) / (2.0 * H_NEWTON);
-            }
-        }
-        jac
-    }
-
-    /// The equilibrium under `δw` near `q0`: Newton's method with the fixed matrix `jac`.
-    fn solve(&mut self, q0: &[f64], jac: &Mat<f64>, dw: &Vector6<f64>) -> Vec<f64> {
-        let n = q0.len();
-        let lu = jac.partial_piv_lu();
-        let norm = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let mut q = q0.to_vec();
-        // Newton stops one step after the residual falls below the tolerance: that step takes
-        // the solution to the round-off floor of the residual.
-        let mut below = false;
-        for _ in 0..50 {
-            let r = self.residual(&q, dw);
-            if norm(&r) < NEWTON_TOLERANCE {
-                if below {
-                    return q;
-                }
-                below = true;
-            }
-            let step = lu.solve(Mat::from_fn(n, 1, |i, _| -r[i]));
-            if below {
-                q = (0..n).map(|i| q[i] + step[(i, 0)]).collect();
-                continue;
-            }
-            // Backtracking: halve the step until the residual decreases.
-            let mut t = 1.0;
-            loop {
-                let trial: Vec<f64> = (0..n).map(|i| q[i] + t * step[(i, 0)]).collect();
-                if norm(&self.residual(&trial, dw)) < norm(&r) || t < 1e-6 {
-                    q = trial;
-                    break;
-                }
-                t *= 0.5;
-            }
-        }
-        let r = self.residual(&q, dw);
-        panic!(
-            "Newton did not converge: residual {:.3e} at {q:?} (from {q0:?}, δw {dw:?})",
-            norm(&r)
-        );
-    }
-
-    /// End-effector displacement and rotation vector from `q0` to `q`, base frame.
-    fn motion(&mut self, q0: &[f64], q: &[f64]) -> Vector6<f64> {
-        let a = self.values.at(q0).1;
-        let b = self.values.at(q).1;
-        let dp = b.translation.vector - a.translation.vector;
-        let dr = (b.rotation * a.rotation.inverse()).scaled_axis();
-        Vector6::new(dp[0], dp[1], dp[2], dr[0], dr[1], dr[2])
-    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -299,6 +299,22 @@ impl EquilibriumSet {
         motion
     }
 
+    /// `J_c δq`: the cable length changes of the joint motion `dq` (dof), through the range
+    /// of `J_c` kept in the set (m).
+    pub(crate) fn cable_motion(&self, dq: &[f64]) -> Vec<f64> {
+        let y: Vec<f64> = (0..self.singular.len())
+            .map(|i| {
+                self.singular[i]
+                    * (0..self.v_range.nrows().min(dq.len()))
+                        .map(|d| self.v_range[(d, i)] * dq[d])
+                        .sum::<f64>()
+            })
+            .collect();
+        (0..self.cable_count())
+            .map(|c| (0..y.len()).map(|i| self.u_range[(c, i)] * y[i]).sum())
+            .collect()
+    }
+
     /// Whether the cables are in force closure at this pose: some strictly positive tension
     /// vector in `null(J_cᵀ)` (every torque can then be held with high enough tensions). One
     /// small LP ([`crate::policy`]); a property, not a condition of feasibility.

@@ -339,13 +339,42 @@ fn limits_certificate(
     let bottom = |w: &[f64]| {
         (0..m).map(|c| w[c] * if w[c] > 0.0 { lower[c] } else { upper[c] }).sum::<f64>()
     };
+    // The solver's certificate is one of many, often a mix of joints; a certificate along one
+    // joint alone names just that joint: take the one that falls shortest by the most, per
+    // newton of cable weight, when there is one. Candidates: each joint's part of the solver's
+    // joint motion and each of its DOFs alone.
+    let shortfall = |w: &[f64]| (demand(w) - top(w)).max(bottom(w) - demand(w)) / norm(w);
+    let direction = set.joint_motion(&w);
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for g in groups {
+        let part: Vec<f64> =
+            (0..direction.len()).map(|d| if g.contains(&d) { direction[d] } else { 0.0 }).collect();
+        let axes = g.clone().map(|d| (0..direction.len()).map(|i| f64::from(i == d)).collect());
+        for dq in std::iter::once(part).chain(axes) {
+            let candidate = set.cable_motion(&dq);
+            if norm(&candidate) == 0.0 {
+                continue;
+            }
+            let by = shortfall(&candidate);
+            let scale = (0..m).map(|c| upper[c].abs().max(lower[c].abs())).fold(0.0, f64::max);
+            if by > 1e-9 * scale && best.as_ref().is_none_or(|(b, _)| by > *b) {
+                best = Some((by, candidate));
+            }
+        }
+    }
+    if let Some((_, single)) = best {
+        w = single;
+    }
     if demand(&w) < bottom(&w) {
         w.iter_mut().for_each(|v| *v = -*v);
     }
     let mut direction = set.joint_motion(&w);
     let scale = direction.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     if scale > 0.0 {
-        direction.iter_mut().for_each(|v| *v /= scale);
+        // Rounding noise (~1e-16) in the other joints' components would read as motion.
+        direction
+            .iter_mut()
+            .for_each(|v| *v = if v.abs() <= 1e-12 * scale { 0.0 } else { *v / scale });
         w.iter_mut().for_each(|v| *v /= scale);
     }
     let largest = w.iter().fold(0.0_f64, |a, v| a.max(v.abs()));

@@ -8,21 +8,10 @@ use rand::Rng;
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, joint_stiffness};
+use sinew_testkit::newton::elastic_cable_torque;
 use sinew_testkit::numeric::{H, central_difference, max_abs};
 use sinew_testkit::random_chain::RandomChain;
 use sinew_testkit::{cdhrm5, config};
-
-/// `τ(Q) = −J_c(Q)ᵀ f(Q)` with elastic cables `f = f0 + K_l (L(Q) − L(Q0))` (spec §3).
-fn cable_torque(robot: &Robot, routing: &Routing, q: &[f64], f0: &[f64], l0: &[f64]) -> Vec<f64> {
-    let mut rdata = RobotData::new(robot);
-    let mut g = RoutingData::new(routing);
-    compute_cable_geometry(routing, robot, &mut rdata, &mut g, q, Order::Jacobian).unwrap();
-    let l = g.lengths().unwrap();
-    let j = g.jacobian().unwrap();
-    let k = routing.cable_stiffness();
-    let f: Vec<f64> = (0..f0.len()).map(|c| f0[c] + k[c] * (l[c] - l0[c])).collect();
-    (0..robot.dof()).map(|d| -(0..f.len()).map(|c| j[(c, d)] * f[c]).sum::<f64>()).collect()
-}
 
 #[test]
 fn k_is_minus_the_derivative_of_the_cable_torque() {
@@ -50,7 +39,7 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
             let l0 = data.cables.lengths().unwrap().to_vec();
             // K is restoring: minus the derivative of the cable torque.
             let numeric =
-                -central_difference(&q, H, |q| cable_torque(&robot, &routing, q, &f0, &l0));
+                -central_difference(&q, H, |q| elastic_cable_torque(&robot, &routing, q, &f0, &l0));
             let k = data.k_q();
             let err = max_abs((k.to_owned() - &numeric).as_ref()) / max_abs(k).max(1.0);
             worst = worst.max(err);
@@ -109,7 +98,7 @@ fn k_at_any_tensions_is_minus_the_derivative_of_the_cable_torque_on_random_geome
             };
             let k = k_at_tensions(&robot, &routing, &q, &f0);
             let numeric =
-                -central_difference(&q, H, |q| cable_torque(&robot, &routing, q, &f0, &l0));
+                -central_difference(&q, H, |q| elastic_cable_torque(&robot, &routing, q, &f0, &l0));
             worst =
                 worst.max(max_abs((k.clone() - &numeric).as_ref()) / max_abs(k.as_ref()).max(1.0));
         }

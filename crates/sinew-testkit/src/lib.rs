@@ -25,5 +25,6 @@
 pub mod alloc;
 pub mod cdhrm5;
 pub mod config;
+pub mod newton;
 pub mod numeric;
 pub mod random_chain;
