@@ -136,7 +136,8 @@ fn check_routing(fx: &Fixture, model: &str, routing: &Routing) {
     for (k, (j, lib)) in joints.iter().zip(fx.robot.joints()).enumerate() {
         assert_eq!(j["index"], k);
         assert_eq!(j["name"], lib.name.as_str());
-        assert_eq!(j["universal_joint"], k / 2);
+        assert_eq!(j["joint"], k / 2);
+        assert_eq!(j["axis_index"], k % 2);
         assert_vec(&j["axis"], &[lib.axis.x, lib.axis.y, lib.axis.z], "axis");
         assert_num(&j["lower"], lib.lower, "lower");
         assert_num(&j["upper"], lib.upper, "upper");

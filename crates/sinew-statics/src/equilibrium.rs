@@ -302,17 +302,24 @@ impl EquilibriumSet {
     /// `J_c δq`: the cable length changes of the joint motion `dq` (dof), through the range
     /// of `J_c` kept in the set (m).
     pub(crate) fn cable_motion(&self, dq: &[f64]) -> Vec<f64> {
-        let y: Vec<f64> = (0..self.singular.len())
-            .map(|i| {
-                self.singular[i]
-                    * (0..self.v_range.nrows().min(dq.len()))
-                        .map(|d| self.v_range[(d, i)] * dq[d])
-                        .sum::<f64>()
-            })
-            .collect();
-        (0..self.cable_count())
-            .map(|c| (0..y.len()).map(|i| self.u_range[(c, i)] * y[i]).sum())
-            .collect()
+        let mut lengths = vec![0.0; self.cable_count()];
+        for b in &self.blocks {
+            let y: Vec<f64> = (0..b.singular.len())
+                .map(|i| {
+                    let dot: f64 = b
+                        .dofs
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &d)| b.v_range[(k, i)] * dq.get(d).copied().unwrap_or(0.0))
+                        .sum();
+                    b.singular[i] * dot
+                })
+                .collect();
+            for (r, &c) in b.cables.iter().enumerate() {
+                lengths[c] = (0..y.len()).map(|i| b.u_range[(r, i)] * y[i]).sum();
+            }
+        }
+        lengths
     }
 
     /// Whether the cables are in force closure at this pose: some strictly positive tension
