@@ -281,7 +281,6 @@ fn render(out: &ArmOut, routing: &sinew::routing::Routing) -> String {
             ]);
         }
         s.push_str(&t.render(2));
-        s.push('\n');
     }
 
     if !out.intervals.is_empty() {

@@ -1126,3 +1126,68 @@ fn an_infeasible_load_under_a_policy_names_the_joint_and_the_motion() {
         ],
     );
 }
+
+/// Every command on the robots beyond the paper's pattern: a planar snake of 1-DOF joints with
+/// a shared cable, and a universal arm with four cables per joint. `routing` and `arm` answer
+/// (the tensions by a policy, least-total by default); the single-joint model (`joint`,
+/// `sweep`), which is the paper's three cables on a universal joint, refuses with one line and
+/// exit 2.
+#[test]
+fn every_command_runs_on_the_general_robots() {
+    let root = sinew_testkit::cdhrm5::workspace_root();
+    for (robot, q, joint_q) in [
+        ("planar-snake", "0.3,-0.2,0.25,-0.1", "0.1"),
+        ("ua3x4", "0.2,-0.3,0.25,0.1,-0.15,0.3", "0.1,0.1"),
+    ] {
+        let dir = root.join("robots").join(robot);
+        let dir = dir.to_str().unwrap();
+        let routing = json(&["routing", "--robot", dir, "--json"]);
+        assert_eq!(routing["model"], "explicit");
+        let default = json(&["arm", "--robot", dir, "--q", q, "--wrench", "0,2,0,0,0,0", "--json"]);
+        assert_eq!(default["policy"], "least-total", "{robot}");
+        assert!(
+            default["notes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|n| n.as_str().unwrap().contains("tension levels need"))
+        );
+        for policy in ["least-total", "least-norm", "safest"] {
+            let doc = json(&[
+                "arm",
+                "--robot",
+                dir,
+                "--q",
+                q,
+                "--wrench",
+                "0,2,0,0,0,0",
+                "--policy",
+                policy,
+                "--json",
+            ]);
+            assert_eq!(doc["stable"], true, "{robot} {policy}");
+            assert!(doc["c_x"].is_array(), "{robot} {policy}");
+            assert_eq!(doc["force_closure"], true, "{robot} {policy}");
+        }
+        assert_fails(
+            &[
+                "arm",
+                "--robot",
+                dir,
+                "--q",
+                q,
+                "--levels",
+                &vec!["0"; if robot == "ua3x4" { 3 } else { 4 }].join(","),
+            ],
+            2,
+            &["tension levels need three cables per universal joint"],
+        );
+        let refusal =
+            if robot == "ua3x4" { "cables of its own" } else { "needs an arm of universal joints" };
+        assert_fails(
+            &["joint", "--robot", dir, "--joint", "1", "--q", joint_q, "--torque", joint_q],
+            2,
+            &[refusal],
+        );
+    }
+}
