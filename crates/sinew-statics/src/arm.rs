@@ -217,6 +217,50 @@ impl ArmStatics {
         EquilibriumSet::new(routing_data.jacobian()?, &data.t0, &self.cable_limits, &self.groups)
     }
 
+    /// The paper's tension levels of balancing `tensions` (one per joint, in `[0, 1]`): where
+    /// each joint's own cables sit on its feasible interval, given the tensions of the cables
+    /// beyond it (routed), as [`ArmStatics::solve`] places them. Needs the closed form and a
+    /// solve at the same `Q` and load (its `T0` in `data`).
+    ///
+    /// # Errors
+    /// [`StaticsError::LevelsUnavailable`]; [`StaticsError::Infeasible`] for a joint whose
+    /// interval is empty; [`StaticsError::DimensionMismatch`].
+    pub fn levels_of(
+        &self,
+        routing_data: &RoutingData,
+        data: &ArmStaticsData,
+        tensions: &[f64],
+    ) -> Result<Vec<f64>, StaticsError> {
+        let layout = self.closed_form()?;
+        let n = layout.joints();
+        if tensions.len() != 3 * n {
+            let got = tensions.len();
+            return Err(StaticsError::DimensionMismatch { what: "tensions", expected: 3 * n, got });
+        }
+        let jacobian = routing_data.jacobian()?;
+        let mut levels = vec![0.0; n];
+        for i in 0..n {
+            let mut tau = Vector2::new(data.t0[2 * i], data.t0[2 * i + 1]);
+            if layout.crossing() {
+                for c in 3 * (i + 1)..3 * n {
+                    tau[0] += jacobian[(c, 2 * i)] * tensions[c];
+                    tau[1] += jacobian[(c, 2 * i + 1)] * tensions[c];
+                }
+            }
+            let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);
+            let interval = crate::interval::tension_interval(i, &block, &tau, self.limits)?;
+            let own = Vector3::new(tensions[3 * i], tensions[3 * i + 1], tensions[3 * i + 2]);
+            let lambda = interval.null.dot(&(own - interval.particular));
+            let width = interval.width();
+            levels[i] = if width > 0.0 {
+                ((lambda - interval.lambda_min) / width).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+        }
+        Ok(levels)
+    }
+
     /// Check that `tensions` are within their limits and balance `t0`.
     fn check_balance(
         &self,
