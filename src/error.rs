@@ -2,6 +2,7 @@
 //! [`ErrorKind`].
 
 use crate::indicators::IndicatorError;
+use crate::planner::PlanError;
 use crate::robot::RobotError;
 use crate::routing::RoutingError;
 use crate::statics::StaticsError;
@@ -35,6 +36,10 @@ pub enum Error {
     /// own variants).
     #[error(transparent)]
     Indicators(IndicatorError),
+    /// The tension planner (its own errors; the errors of the crates below arrive in their own
+    /// variants). Boxed, as it is large.
+    #[error(transparent)]
+    Planner(Box<PlanError>),
     /// Anything else, with its message (e.g. a URDF read for a report).
     #[error("{message}")]
     Other {
@@ -90,6 +95,7 @@ impl Error {
             Error::Statics(e) => statics_kind(e),
             Error::Stiffness(e) => stiffness_kind(e),
             Error::Indicators(e) => indicator_kind(e),
+            Error::Planner(e) => planner_kind(e),
             Error::Other { .. } => ErrorKind::Input,
         }
     }
@@ -157,6 +163,32 @@ fn indicator_kind(e: &IndicatorError) -> ErrorKind {
         IndicatorError::Robot(e) => robot_kind(e),
         // Joints, directions, grids, routings the probe cannot take: the caller's input.
         _ => ErrorKind::Input,
+    }
+}
+
+fn planner_kind(e: &PlanError) -> ErrorKind {
+    match e {
+        // No tensions meet what was asked: an answer of the model, like an infeasible load.
+        PlanError::NoStableTensions { .. }
+        | PlanError::RequirementUnreachable { .. }
+        | PlanError::BudgetTooSmall { .. } => ErrorKind::Infeasible,
+        PlanError::NoEndStiffness => ErrorKind::RankDeficient,
+        PlanError::NonConservativeLoad { .. } | PlanError::InvalidInput { .. } => ErrorKind::Input,
+        PlanError::Statics(e) => statics_kind(e),
+        PlanError::Stiffness(e) => stiffness_kind(e),
+        PlanError::Routing(e) => routing_kind(e),
+        _ => ErrorKind::Numerical,
+    }
+}
+
+impl From<PlanError> for Error {
+    fn from(e: PlanError) -> Self {
+        match e {
+            PlanError::Statics(e) => (*e).into(),
+            PlanError::Stiffness(e) => (*e).into(),
+            PlanError::Routing(e) => (*e).into(),
+            e => Error::Planner(Box::new(e)),
+        }
     }
 }
 

@@ -15,6 +15,8 @@
 //! - [`stiffness`]: joint stiffness, `K_q`, end compliance and stiffness (`sinew-stiffness`).
 //! - [`indicators`]: the paper's joint indicators, sweeps and stiffness ellipsoids
 //!   (`sinew-indicators`).
+//! - [`planner`]: the tensions that optimise the end stiffness, certified by a gap
+//!   (`sinew-planner`).
 //!
 //! [`paper`] holds the paper's experiments (spec §6) as data, checks and fixed-precision
 //! tables, for `cargo xtask reproduce` and the snapshot tests; [`Error`] gathers every crate's
@@ -29,6 +31,7 @@ pub mod paper;
 
 pub use error::{Error, ErrorKind};
 pub use sinew_indicators as indicators;
+pub use sinew_planner as planner;
 pub use sinew_robot as robot;
 pub use sinew_routing as routing;
 pub use sinew_statics as statics;

@@ -1,0 +1,121 @@
+//! The one error type of this crate.
+
+use sinew_robot::Compact;
+
+/// Everything a plan can end in besides an answer.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlanError {
+    /// A moment in the load: `K_W` is then not symmetric, `K_x` is not concave in the
+    /// tensions, and a local optimum need not be the global one. Refused.
+    #[error(
+        "the load has a moment [{}, {}, {}] N m: with a moment K_W is not symmetric and the end stiffness is not concave in the tensions, so no optimum can be certified; plan under forces only",
+        Compact(.moment[0]), Compact(.moment[1]), Compact(.moment[2])
+    )]
+    NonConservativeLoad {
+        /// The moment part of `F0`, N m.
+        moment: [f64; 3],
+    },
+    /// A bad argument: a zero or non-finite direction, a negative budget or margin, a `K_des`
+    /// that is not symmetric positive definite, a NaN.
+    #[error("{what}: {problem}")]
+    InvalidInput {
+        /// The argument.
+        what: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// No tensions within the limits (and the budget) keep the arm stable with the margin
+    /// asked for; `best` bounds every reachable margin from above.
+    #[error(
+        "no tensions within the limits{} keep the arm stable with margin {} N m/rad: the best reachable margin is at most {} N m/rad",
+        if *.budget { " and the budget" } else { "" }, Compact(*.margin), Compact(*.best)
+    )]
+    NoStableTensions {
+        /// The margin asked for, N m/rad.
+        margin: f64,
+        /// An upper bound of the best reachable margin, N m/rad.
+        best: f64,
+        /// Whether a tension budget was part of the constraints.
+        budget: bool,
+    },
+    /// The tension budget is below the least total tension that balances the load.
+    #[error(
+        "the tension budget {} N is below the least total tension that balances the load, {} N",
+        Compact(*.budget), Compact(*.least)
+    )]
+    BudgetTooSmall {
+        /// The budget, N.
+        budget: f64,
+        /// The least total tension, N.
+        least: f64,
+    },
+    /// The required stiffness cannot be reached within the constraints.
+    #[error(
+        "the required {what} {} exceeds the best reachable, at most {} (the tension limits, budget and margin allow no more)",
+        Compact(*.required), Compact(*.best)
+    )]
+    RequirementUnreachable {
+        /// Which requirement.
+        what: &'static str,
+        /// The value asked for.
+        required: f64,
+        /// An upper bound of the best reachable value.
+        best: f64,
+    },
+    /// The objective needs `K_x`, which does not exist: `J_x` has rank < 6 (e.g. a planar arm).
+    #[error(
+        "the end stiffness K_x does not exist at this pose (J_x has rank < 6): choose the compliance objective"
+    )]
+    NoEndStiffness,
+    /// The method stopped before its gap closed.
+    #[error(
+        "no certified optimum after {iterations} iterations: gap {} above the tolerance {}",
+        Compact(*.gap), Compact(*.tolerance)
+    )]
+    NotConverged {
+        /// Iterations run.
+        iterations: usize,
+        /// The gap reached.
+        gap: f64,
+        /// The gap asked for.
+        tolerance: f64,
+    },
+    /// The convex solver (clarabel) stopped without an answer or a certificate.
+    #[error("the convex solver stopped without an answer: {status}")]
+    Solver {
+        /// Its status.
+        status: String,
+    },
+    /// The statics (infeasible loads among them). Boxed, as it is large.
+    #[error(transparent)]
+    Statics(Box<sinew_statics::StaticsError>),
+    /// The stiffness pipeline.
+    #[error(transparent)]
+    Stiffness(Box<sinew_stiffness::StiffnessError>),
+    /// The cable geometry.
+    #[error(transparent)]
+    Routing(Box<sinew_routing::RoutingError>),
+}
+
+impl From<sinew_statics::StaticsError> for PlanError {
+    fn from(e: sinew_statics::StaticsError) -> Self {
+        PlanError::Statics(Box::new(e))
+    }
+}
+
+impl From<sinew_stiffness::StiffnessError> for PlanError {
+    fn from(e: sinew_stiffness::StiffnessError) -> Self {
+        // An infeasible load reaches the stiffness pipeline through its statics: keep one path.
+        match e {
+            sinew_stiffness::StiffnessError::Statics(s) => PlanError::Statics(Box::new(s)),
+            e => PlanError::Stiffness(Box::new(e)),
+        }
+    }
+}
+
+impl From<sinew_routing::RoutingError> for PlanError {
+    fn from(e: sinew_routing::RoutingError) -> Self {
+        PlanError::Routing(Box::new(e))
+    }
+}

@@ -1,0 +1,33 @@
+//! # sinew-planner
+//!
+//! The tensions that make the arm stiffest where it matters, with static equilibrium exact,
+//! every tension within its limits and the arm stable — each answer certified by a gap.
+//!
+//! # Math
+//! Every balancing tension vector is `f = f_p + N λ` (the equilibrium set of
+//! [`sinew_statics::EquilibriumSet`], any cable set); the limits make `λ` range over a polytope.
+//! `K_q` is affine in `λ` (the controllable part `Σ f_c H_c` is linear in `f`, the inherent part
+//! does not depend on it), so `A(λ) = K_q + K_W = A_0 + Σ λ_i A_i`, symmetric under a
+//! conservative load (gravity and a force, no moment). On `{A ≻ 0}` the end stiffness
+//! `K_x = (J_x A⁻¹ J_xᵀ)⁻¹` is matrix-concave in `λ`: `wᵀ K_x w = min { δqᵀ A δq : J_x δq = w }`
+//! is a minimum of functions affine in `λ`. Hence `uᵀ K_fd u`, `λ_min(K_fd)`, `log det K_fd`
+//! and the stability margin `λ_min(A)` are concave and `uᵀ C_x u` convex: each objective
+//! ([`Objective`]) is a convex problem, whose local optimum is the global one. `pencil.rs` has
+//! the supergradients; `bundle.rs` the method (a level bundle method on clarabel LPs and QPs,
+//! no PSD cone, so no system BLAS), whose LP bound certifies every answer ([`Plan::gap`]). With
+//! a moment in the load `K_W` is not symmetric and the argument fails:
+//! [`PlanError::NonConservativeLoad`].
+//!
+//! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). The
+//! solver allocates inside its iterations (clarabel builds each subproblem).
+#![deny(missing_docs)]
+
+mod bundle;
+mod error;
+mod pencil;
+mod plan;
+
+pub use error::PlanError;
+pub use plan::{
+    DEFAULT_GAP, DEFAULT_MARGIN, Objective, Plan, PlanSettings, Planner, PlannerData, Requirements,
+};

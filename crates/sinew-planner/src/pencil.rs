@@ -1,0 +1,170 @@
+//! The joint stiffness as an affine function of the equilibrium set's coordinates, and the end
+//! stiffness functions of it with their supergradients.
+//!
+//! # Math
+//! On `f = f_p + N λ` the controllable stiffness `Σ_c f_c H_c` is linear in `f` and the inherent
+//! part `J_cᵀ K_l J_c` does not depend on it, so
+//! `A(λ) = K_q(λ) + K_W = A_0 + Σ_i λ_i A_i` with `A_0 = J_cᵀ K_l J_c + Σ_c f_p,c H_c + K_W` and
+//! `A_i = Σ_c N_ci H_c`. Where `A ≻ 0`, `C_x = J_x A⁻¹ J_xᵀ` and `K_x = C_x⁻¹`, and
+//! `wᵀ K_x w = min { δqᵀ A δq : J_x δq = w }` is concave in `λ`, with supergradient
+//! `∂/∂λ_i = zᵀ A_i z`, `z = A⁻¹ J_xᵀ K_x w` (the minimiser). Likewise `−uᵀ C_x u` with
+//! `z = A⁻¹ J_xᵀ u`, `λ_min(K_fd)` (its eigenvector's `w`), `log det K_fd`
+//! (`Σ_a y_aᵀ A_i y_a`, `Y = A⁻¹ J_xᵀ K_x[:, 0:3] L⁻ᵀ`, `L Lᵀ = K_fd`) and the stability
+//! margin `λ_min(A)` (its eigenvector `v`: `vᵀ A_i v`).
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, MatRef, Side};
+use nalgebra::{Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
+
+use crate::error::PlanError;
+
+/// `A(λ) = A_0 + Σ λ_i A_i` with `J_x`, at one pose and load.
+#[derive(Debug, Clone)]
+pub(crate) struct Pencil {
+    pub(crate) a0: Mat<f64>,
+    pub(crate) ai: Vec<Mat<f64>>,
+    pub(crate) j_x: Mat<f64>,
+}
+
+/// The end quantities at a point where `A ≻ 0`.
+pub(crate) struct End {
+    /// `A⁻¹ J_xᵀ` (dof × 6).
+    y: Mat<f64>,
+    pub(crate) c_x: Matrix6<f64>,
+    /// `None` when `C_x` is singular (`J_x` rank-deficient).
+    pub(crate) k_x: Option<Matrix6<f64>>,
+}
+
+impl Pencil {
+    /// `A(λ)`, symmetrised.
+    pub(crate) fn at(&self, lambda: &[f64]) -> Mat<f64> {
+        let n = self.a0.nrows();
+        Mat::from_fn(n, n, |r, c| {
+            let mut v = 0.5 * (self.a0[(r, c)] + self.a0[(c, r)]);
+            for (l, a) in lambda.iter().zip(&self.ai) {
+                v += l * 0.5 * (a[(r, c)] + a[(c, r)]);
+            }
+            v
+        })
+    }
+
+    /// `(zᵀ A_i z)_i`.
+    pub(crate) fn forms(&self, z: MatRef<'_, f64>) -> Vec<f64> {
+        let n = z.nrows();
+        self.ai
+            .iter()
+            .map(|a| {
+                let mut s = 0.0;
+                for col in 0..z.ncols() {
+                    for r in 0..n {
+                        let zr = z[(r, col)];
+                        if zr == 0.0 {
+                            continue;
+                        }
+                        for c in 0..n {
+                            s += zr * a[(r, c)] * z[(c, col)];
+                        }
+                    }
+                }
+                s
+            })
+            .collect()
+    }
+
+    /// The stability margin `λ_min(A(λ))` and its supergradient.
+    pub(crate) fn margin(&self, lambda: &[f64]) -> Result<(f64, Vec<f64>), PlanError> {
+        let a = self.at(lambda);
+        let eigen = a
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|_| PlanError::Solver { status: "eigendecomposition of K_q + K_W".into() })?;
+        let value = eigen.S().column_vector()[0];
+        let v = eigen.U().subcols(0, 1);
+        Ok((value, self.forms(v)))
+    }
+
+    /// `C_x` and `K_x` at `λ`, `None` where `A(λ)` is not positive definite.
+    pub(crate) fn end(&self, lambda: &[f64]) -> Option<End> {
+        let a = self.at(lambda);
+        let llt = a.llt(Side::Lower).ok()?;
+        let y = llt.solve(self.j_x.transpose());
+        let c_x = Matrix6::from_fn(|r, c| {
+            (0..y.nrows()).map(|d| self.j_x[(r, d)] * y[(d, c)]).sum::<f64>()
+        });
+        let c_x = 0.5 * (c_x + c_x.transpose());
+        // K_x only where C_x is well conditioned (J_x of rank 6): an eigenvalue below 1e-12
+        // of the largest is a rank deficiency, not a stiffness.
+        let eigenvalues = c_x.symmetric_eigenvalues();
+        let full_rank = eigenvalues.min() > 1e-12 * eigenvalues.max();
+        let k_x =
+            if full_rank { c_x.try_inverse().map(|k| 0.5 * (k + k.transpose())) } else { None };
+        if !c_x.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        Some(End { y, c_x, k_x })
+    }
+}
+
+impl End {
+    /// `K_fd = K_x[0:3, 0:3]`.
+    pub(crate) fn k_fd(&self) -> Option<Matrix3<f64>> {
+        self.k_x.map(|k| k.fixed_view::<3, 3>(0, 0).into_owned())
+    }
+
+    /// `wᵀ K_x w` and its gradient in `λ`.
+    pub(crate) fn stiffness_form(
+        &self,
+        pencil: &Pencil,
+        w: &Vector6<f64>,
+    ) -> Option<(f64, Vec<f64>)> {
+        let k_x = self.k_x?;
+        let kw = k_x * w;
+        let z =
+            Mat::from_fn(self.y.nrows(), 1, |d, _| (0..6).map(|j| self.y[(d, j)] * kw[j]).sum());
+        Some((w.dot(&kw), pencil.forms(z.as_ref())))
+    }
+
+    /// `−uᵀ C_x[0:3, 0:3] u` (the compliance along `u` with rotations free, negated) and its
+    /// gradient.
+    pub(crate) fn compliance_form(&self, pencil: &Pencil, u: &Vector3<f64>) -> (f64, Vec<f64>) {
+        let z = Mat::from_fn(self.y.nrows(), 1, |d, _| (0..3).map(|j| self.y[(d, j)] * u[j]).sum());
+        let c = self.c_x.fixed_view::<3, 3>(0, 0).into_owned();
+        (-(u.dot(&(c * u))), pencil.forms(z.as_ref()))
+    }
+
+    /// `λ_min(K_fd)` (of `S⁻¹ K_fd S⁻ᵀ` when `scale = S` is given) and its supergradient.
+    pub(crate) fn least_stiffness(
+        &self,
+        pencil: &Pencil,
+        scale: Option<&Matrix3<f64>>,
+    ) -> Option<(f64, Vec<f64>)> {
+        let k_fd = self.k_fd()?;
+        let (m, back) = match scale {
+            Some(s) => {
+                let s_inv = s.try_inverse()?;
+                (s_inv * k_fd * s_inv.transpose(), s_inv.transpose())
+            }
+            None => (k_fd, Matrix3::identity()),
+        };
+        let eigen = SymmetricEigen::new(0.5 * (m + m.transpose()));
+        let i = eigen.eigenvalues.imin();
+        let v = back * eigen.eigenvectors.column(i).into_owned();
+        let w = Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0);
+        let (_, gradient) = self.stiffness_form(pencil, &w)?;
+        Some((eigen.eigenvalues[i], gradient))
+    }
+
+    /// `log det K_fd` and its gradient.
+    pub(crate) fn log_volume(&self, pencil: &Pencil) -> Option<(f64, Vec<f64>)> {
+        let k_x = self.k_x?;
+        let k_fd = self.k_fd()?;
+        let l = k_fd.cholesky()?.l();
+        let l_inv_t = l.try_inverse()?.transpose();
+        // Y = A⁻¹ J_xᵀ K_x[:, 0:3] L⁻ᵀ (dof × 3).
+        let k3 = k_x.fixed_view::<6, 3>(0, 0).into_owned() * l_inv_t;
+        let z = Mat::from_fn(self.y.nrows(), 3, |d, a| {
+            (0..6).map(|j| self.y[(d, j)] * k3[(j, a)]).sum()
+        });
+        let value = 2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>();
+        Some((value, pencil.forms(z.as_ref())))
+    }
+}
