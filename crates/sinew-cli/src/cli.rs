@@ -48,6 +48,14 @@ pub enum Command {
     /// feasible tensions at each point, empty
     /// (null in JSON) where the torque cannot be held.
     Sweep(SweepArgs),
+    /// The tensions that optimise the end stiffness in a pose under a load, certified.
+    ///
+    /// Keeps static equilibrium exactly, every tension within its limits and the arm stable
+    /// (smallest eigenvalue of K_q + K_W ≥ --margin), within an optional --budget on the total
+    /// tension. The end stiffness is concave in the tensions (under gravity and a force, no
+    /// moment), so the optimum is global; the answer carries a gap: the true optimum is at most
+    /// `gap` better. Any cable set, both models.
+    Plan(PlanArgs),
     /// Write a Sinew robot folder from another tool's model files.
     #[command(subcommand)]
     Import(ImportSource),
@@ -217,6 +225,63 @@ pub struct ArmArgs {
     /// cable set): least total tension, least 2-norm, or farthest from the limits.
     #[arg(long, value_enum)]
     pub policy: Option<Policy>,
+    /// Ignore gravity (zero gravity vector instead of robot.toml's).
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Read --q in degrees (the output stays in radians).
+    #[arg(long)]
+    pub deg: bool,
+}
+
+/// What `sinew plan` optimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlanObjective {
+    /// Maximise u·K_fd·u, the stiffness along --direction with the end's rotation held (N/m).
+    StiffnessAlong,
+    /// Minimise u·C_x·u, the compliance along --direction with rotations free (m/N).
+    ComplianceAlong,
+    /// Maximise the smallest eigenvalue of K_fd: the softest direction (N/m).
+    MinStiffness,
+    /// Maximise log det K_fd: the smallest deformation ellipsoid.
+    Volume,
+    /// Minimise the total tension (N) subject to --k-min, --k-des and --margin.
+    LeastTension,
+}
+
+/// `sinew plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// The pose: one angle per revolute joint, base first (rad; degrees with --deg).
+    #[arg(long, value_name = "Q1,...,Qd", allow_hyphen_values = true)]
+    pub q: String,
+    /// F0, the wrench the end-effector exerts, base frame: FX,FY,FZ,MX,MY,MZ (N, N m). The
+    /// moment must be zero. Default zero.
+    #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
+    pub wrench: Option<String>,
+    /// What to optimise.
+    #[arg(long, value_enum)]
+    pub objective: PlanObjective,
+    /// The direction of stiffness-along and compliance-along: UX,UY,UZ (base frame, any
+    /// non-zero length: it is normalised).
+    #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
+    pub direction: Option<String>,
+    /// Require the smallest eigenvalue of K_fd to be at least this (N/m).
+    #[arg(long, value_name = "N/m", allow_hyphen_values = true)]
+    pub k_min: Option<String>,
+    /// Require K_fd ⪰ K_des: nine numbers, row by row, symmetric positive definite (N/m).
+    #[arg(long, value_name = "K11,...,K33", allow_hyphen_values = true)]
+    pub k_des: Option<String>,
+    /// Stability margin: smallest eigenvalue of K_q + K_W at least this (N m/rad, > 0).
+    #[arg(long, value_name = "N·m/rad", allow_hyphen_values = true)]
+    pub margin: Option<String>,
+    /// Total tension at most this (N).
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub budget: Option<String>,
+    /// Stop when the certified gap is at most this fraction of the value (default 1e-6).
+    #[arg(long, value_name = "REL", allow_hyphen_values = true)]
+    pub gap: Option<String>,
     /// Ignore gravity (zero gravity vector instead of robot.toml's).
     #[arg(long)]
     pub no_gravity: bool,

@@ -4,6 +4,7 @@ use std::fmt;
 
 use sinew::ErrorKind;
 use sinew::indicators::IndicatorError;
+use sinew::planner::PlanError;
 use sinew::robot::RobotError;
 use sinew::statics::StaticsError;
 
@@ -63,6 +64,9 @@ pub fn library_error(e: impl Into<sinew::Error>) -> CliError {
     let e: sinew::Error = e.into();
     let kind = e.kind();
     let message = match (kind, option_of(&e)) {
+        (ErrorKind::Infeasible, _) if matches!(e, sinew::Error::Planner(_)) => {
+            format!("infeasible: {e}")
+        }
         (ErrorKind::Infeasible, _) => format!("infeasible load: {e}"),
         (_, Some(option)) => format!("{option}: {e}"),
         (_, None) => e.to_string(),
@@ -80,6 +84,11 @@ fn option_of(e: &sinew::Error) -> Option<String> {
             StaticsError::InvalidLevel { .. } => Some("--levels".to_owned()),
             StaticsError::NonFiniteWrench { .. } => Some("--wrench".to_owned()),
             StaticsError::NonFiniteTorque { .. } => Some("--torque".to_owned()),
+            _ => None,
+        },
+        sinew::Error::Planner(p) => match &**p {
+            PlanError::NonConservativeLoad { .. } => Some("--wrench".to_owned()),
+            PlanError::InvalidInput { what, .. } => Some(format!("--{}", what.replace('_', "-"))),
             _ => None,
         },
         sinew::Error::Indicators(i) => match i {

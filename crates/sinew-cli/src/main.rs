@@ -5,6 +5,7 @@
 //! - `sinew joint`: one joint's feasible tension interval and stiffness range;
 //! - `sinew arm`: T0, tensions, K_q, K_W, C_x, K_x, K_fd, the ellipsoid and stability;
 //! - `sinew sweep`: a joint's min/max stiffness maps over its angles (Fig. 5);
+//! - `sinew plan`: the tensions that optimise the end stiffness, certified by a gap;
 //! - `sinew import caspr`: a robot folder from a CASPR model's XML files.
 //!
 //! Errors print one line, `sinew: <message>`, on standard error and exit with 2 (bad input)
@@ -17,6 +18,7 @@ mod import_cmd;
 mod input;
 mod joint_cmd;
 mod output;
+mod plan_cmd;
 mod routing_cmd;
 mod sweep_cmd;
 
@@ -33,6 +35,7 @@ fn run(cli: &Cli) -> Result<(), CliError> {
         Command::Joint(args) => joint_cmd::run(args),
         Command::Arm(args) => arm_cmd::run(args),
         Command::Sweep(args) => sweep_cmd::run(args),
+        Command::Plan(args) => plan_cmd::run(args),
         Command::Import(ImportSource::Caspr(args)) => import_cmd::caspr(args),
     }
 }

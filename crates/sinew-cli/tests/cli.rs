@@ -1191,3 +1191,122 @@ fn every_command_runs_on_the_general_robots() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// sinew plan
+
+#[test]
+fn plan_answers_with_a_certificate_and_its_levels_reproduce_the_arm() {
+    let fx = Fixture::new();
+    let q = list(&E4_Q);
+    let base = ["plan", "--robot", fx.path(), "--q", &q, "--wrench", "0,5,0,0,0,0", "--json"];
+    let doc =
+        json(&[&base[..], &["--objective", "stiffness-along", "--direction", "0,2,0"]].concat());
+    for key in [
+        "objective",
+        "value",
+        "gap",
+        "lambda",
+        "levels",
+        "tensions",
+        "total_tension",
+        "k_fd",
+        "c_x",
+        "min_eigenvalue",
+        "stable",
+        "iterations",
+        "q",
+        "wrench",
+        "direction",
+        "margin",
+    ] {
+        assert!(doc.get(key).is_some(), "key {key} missing: {doc}");
+    }
+    assert_eq!(doc["objective"], "stiffness-along");
+    assert_vec(&doc["direction"], &[0.0, 1.0, 0.0], "direction normalised");
+    let value = doc["value"].as_f64().unwrap();
+    let gap = doc["gap"].as_f64().unwrap();
+    assert!(gap >= 0.0 && gap <= 1e-6 * value, "gap {gap} for {value}");
+    assert_eq!(doc["stable"], true);
+    // `sinew arm` at the returned levels gives the same K_fd.
+    let levels: Vec<f64> =
+        doc["levels"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let s = list(&levels);
+    let arm = json(&[
+        "arm",
+        "--robot",
+        fx.path(),
+        "--q",
+        &q,
+        "--wrench",
+        "0,5,0,0,0,0",
+        "--levels",
+        &s,
+        "--json",
+    ]);
+    let (a, b) = (&arm["k_fd"], &doc["k_fd"]);
+    for r in 0..3 {
+        for c in 0..3 {
+            let (x, y) = (a[r][c].as_f64().unwrap(), b[r][c].as_f64().unwrap());
+            assert!((x - y).abs() <= 1e-8 * value, "K_fd[{r}][{c}]: arm {x}, plan {y}");
+        }
+    }
+    assert!((arm["k_fd"][1][1].as_f64().unwrap() - value).abs() <= 1e-8 * value);
+    // Tables by default.
+    let table = String::from_utf8(
+        run(&base[..base.len() - 1]
+            .iter()
+            .copied()
+            .chain(["--objective", "volume"])
+            .collect::<Vec<_>>())
+        .stdout,
+    )
+    .unwrap();
+    assert!(table.contains("certified: within"), "{table}");
+}
+
+#[test]
+fn plan_refuses_bad_input_and_reports_the_unreachable() {
+    let fx = Fixture::new();
+    let q = list(&E4_Q);
+    let base = ["plan", "--robot", fx.path(), "--q", &q];
+    let with = |extra: &[&'static str]| -> Vec<String> {
+        base.iter().map(|s| s.to_string()).chain(extra.iter().map(|s| s.to_string())).collect()
+    };
+    for (extra, code, needles) in [
+        (vec!["--objective", "sideways"], 2, vec!["sideways"]),
+        (vec!["--objective", "stiffness-along", "--direction", "0,0,0"], 2, vec!["--direction"]),
+        (vec!["--objective", "stiffness-along"], 2, vec!["needs --direction"]),
+        (
+            vec!["--objective", "least-tension", "--k-des", "1,2,0,0,1,0,0,0,1"],
+            2,
+            vec!["--k-des", "symmetric positive definite"],
+        ),
+        (
+            vec!["--objective", "volume", "--wrench", "0,5,0,0.1,0,0"],
+            2,
+            vec!["--wrench", "moment", "not symmetric"],
+        ),
+        (vec!["--objective", "volume", "--budget=-5"], 2, vec!["--budget"]),
+        (vec!["--objective", "volume", "--margin=-1"], 2, vec!["--margin"]),
+        (vec!["--objective", "volume", "--budget", "50"], 1, vec!["infeasible", "budget"]),
+        (
+            vec!["--objective", "least-tension", "--k-min", "1e6"],
+            1,
+            vec!["infeasible", "exceeds the best reachable"],
+        ),
+    ] {
+        let args = with(&extra);
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = run(&refs);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{extra:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        if code == 1 || !needles.contains(&"sideways") {
+            assert_eq!(stderr.lines().count(), 1, "{extra:?}: {stderr}");
+        }
+        for n in needles {
+            assert!(stderr.contains(n), "{extra:?}: `{n}` missing in {stderr}");
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! `sinew plan`: the tensions that optimise the end stiffness, certified by a gap.
+
+use nalgebra::{Matrix3, Vector3, Vector6};
+use serde::Serialize;
+use sinew::planner::{
+    DEFAULT_GAP, DEFAULT_MARGIN, Objective, PlanSettings, Planner, PlannerData, Requirements,
+};
+use sinew::stiffness::ArmStiffness;
+
+use crate::cli::{PlanArgs, PlanObjective};
+use crate::error::{CliError, library_error};
+use crate::input::{check_limits, load, numbers, numbers_n, to_radians};
+use crate::output::{Fmt, Rows, Table, cartesian_labels, emit, matrix, na_rows, print_json};
+
+/// The JSON document of `sinew plan`.
+#[derive(Debug, Serialize)]
+struct PlanOut {
+    command: &'static str,
+    robot: String,
+    routing_file: String,
+    model: &'static str,
+    gravity: [f64; 3],
+    q: Vec<f64>,
+    wrench: Vec<f64>,
+    objective: &'static str,
+    /// The unit direction of stiffness-along / compliance-along.
+    direction: Option<[f64; 3]>,
+    k_min: Option<f64>,
+    k_des: Option<Rows>,
+    margin: f64,
+    budget: Option<f64>,
+    /// The relative gap asked for.
+    tolerance: f64,
+    value: f64,
+    gap: f64,
+    lambda: Vec<f64>,
+    levels: Option<Vec<f64>>,
+    cables: Vec<String>,
+    tensions: Vec<f64>,
+    total_tension: f64,
+    k_fd: Option<Rows>,
+    c_x: Rows,
+    min_eigenvalue: f64,
+    stable: bool,
+    iterations: usize,
+}
+
+fn one_number(option: &str, text: &str) -> Result<f64, CliError> {
+    Ok(numbers_n(option, text, 1, "number")?[0])
+}
+
+/// Run `sinew plan`.
+pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+    let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
+    let (robot, routing) = (&loaded.robot, &loaded.routing);
+    let dof = robot.dof();
+    let mut q = numbers_n("--q", &args.q, dof, &format!("angles (one per revolute joint, {dof})"))?;
+    to_radians(&mut q, args.deg);
+    check_limits(robot, &q)?;
+    let wrench = match &args.wrench {
+        Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
+        None => vec![0.0; 6],
+    };
+    let direction = match &args.direction {
+        Some(text) => {
+            let u = numbers_n("--direction", text, 3, "components (UX,UY,UZ)")?;
+            let u = Vector3::new(u[0], u[1], u[2]);
+            let n = u.norm();
+            if !(n.is_finite() && n > 0.0) {
+                return Err(CliError::input("--direction: must be a finite, non-zero vector"));
+            }
+            Some(u / n)
+        }
+        None => None,
+    };
+    let need_direction = |what: &str| {
+        direction.ok_or_else(|| CliError::input(format!("--objective {what} needs --direction")))
+    };
+    let objective = match args.objective {
+        PlanObjective::StiffnessAlong => {
+            Objective::StiffnessAlong(need_direction("stiffness-along")?)
+        }
+        PlanObjective::ComplianceAlong => {
+            Objective::ComplianceAlong(need_direction("compliance-along")?)
+        }
+        PlanObjective::MinStiffness => Objective::MinStiffness,
+        PlanObjective::Volume => Objective::Volume,
+        PlanObjective::LeastTension => Objective::LeastTension,
+    };
+    let k_des = match &args.k_des {
+        Some(text) => {
+            let k = numbers_n("--k-des", text, 9, "entries (K11,...,K33, row by row)")?;
+            Some(Matrix3::from_row_slice(&k))
+        }
+        None => None,
+    };
+    let requirements = Requirements {
+        margin: args
+            .margin
+            .as_deref()
+            .map(|t| one_number("--margin", t))
+            .transpose()?
+            .unwrap_or(DEFAULT_MARGIN),
+        budget: args.budget.as_deref().map(|t| one_number("--budget", t)).transpose()?,
+        k_min: args.k_min.as_deref().map(|t| one_number("--k-min", t)).transpose()?,
+        k_des,
+    };
+    let tolerance = match &args.gap {
+        Some(text) => numbers("--gap", text)?.first().copied().unwrap_or(DEFAULT_GAP),
+        None => DEFAULT_GAP,
+    };
+    let settings = PlanSettings { relative_gap: tolerance, ..PlanSettings::default() };
+    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
+    let planner = Planner::new(arm);
+    let mut data = PlannerData::new(&planner);
+    let f0 = Vector6::from_column_slice(&wrench);
+    let plan = planner
+        .plan(&mut data, &q, &f0, objective, &requirements, &settings)
+        .map_err(library_error)?;
+    let g = robot.gravity();
+    let out = PlanOut {
+        command: "plan",
+        robot: robot.name().to_owned(),
+        routing_file: loaded.routing_file.display().to_string(),
+        model: args.common.model.name(),
+        gravity: [g.x, g.y, g.z],
+        q,
+        wrench,
+        objective: objective.name(),
+        direction: direction.map(|u| [u.x, u.y, u.z]),
+        k_min: requirements.k_min,
+        k_des: requirements.k_des.map(|k| na_rows(&k)),
+        margin: requirements.margin,
+        budget: requirements.budget,
+        tolerance,
+        value: plan.value,
+        gap: plan.gap,
+        lambda: plan.lambda.clone(),
+        levels: plan.levels.clone(),
+        cables: routing.cables().iter().map(|c| c.name.clone()).collect(),
+        tensions: plan.tensions.clone(),
+        total_tension: plan.total_tension,
+        k_fd: plan.k_fd.map(|k| na_rows(&k)),
+        c_x: na_rows(&plan.c_x),
+        min_eigenvalue: plan.min_eigenvalue,
+        stable: plan.min_eigenvalue > 0.0,
+        iterations: plan.iterations,
+    };
+    if args.common.json { print_json(&out) } else { emit(&render(&out)) }
+}
+
+fn unit(objective: &str) -> &'static str {
+    match objective {
+        "stiffness-along" | "min-stiffness" => "N/m",
+        "compliance-along" => "m/N",
+        "least-tension" => "N",
+        _ => "(ln of (N/m)³)",
+    }
+}
+
+fn render(out: &PlanOut) -> String {
+    let mut s = String::new();
+    s.push_str(&format!(
+        "plan for `{}` ({}: {}), gravity {} m/s²\n",
+        out.robot,
+        out.model,
+        out.routing_file,
+        Fmt::Fixed(3).list(&out.gravity)
+    ));
+    s.push_str(&format!("  Q  = {} rad\n", Fmt::Fixed(5).list(&out.q)));
+    s.push_str(&format!("  F0 = {} (N, N m)\n", Fmt::Fixed(4).list(&out.wrench)));
+    let mut asked = format!("  objective {}", out.objective);
+    if let Some(u) = out.direction {
+        asked.push_str(&format!(" along {}", Fmt::Fixed(4).list(&u)));
+    }
+    asked.push_str(&format!("; margin ≥ {} N m/rad", Fmt::Sci(3).num(out.margin)));
+    if let Some(b) = out.budget {
+        asked.push_str(&format!(", Σf ≤ {} N", Fmt::Fixed(3).num(b)));
+    }
+    if let Some(k) = out.k_min {
+        asked.push_str(&format!(", λ_min(K_fd) ≥ {} N/m", Fmt::Fixed(3).num(k)));
+    }
+    if out.k_des.is_some() {
+        asked.push_str(", K_fd ⪰ K_des");
+    }
+    s.push_str(&asked);
+    s.push_str("\n\n");
+    s.push_str(&format!(
+        "Optimum: {} {} (certified: within {} of the true optimum; {} iterations)\n",
+        Fmt::Sci(8).num(out.value),
+        unit(out.objective),
+        Fmt::Sci(2).num(out.gap),
+        out.iterations
+    ));
+    s.push_str(&format!(
+        "  total tension {} N, smallest eigenvalue of K_q + K_W {} N m/rad\n",
+        Fmt::Fixed(3).num(out.total_tension),
+        Fmt::Fixed(6).num(out.min_eigenvalue)
+    ));
+    if let Some(levels) = &out.levels {
+        s.push_str(&format!("  tension levels = {}\n", Fmt::Fixed(4).list(levels)));
+    }
+    s.push('\n');
+    let mut t = Table::new(&["cable", "f (N)"]).left(&[0]);
+    for (name, f) in out.cables.iter().zip(&out.tensions) {
+        t.row(vec![name.clone(), Fmt::Fixed(3).num(*f)]);
+    }
+    s.push_str(&t.render(2));
+    let cl = cartesian_labels();
+    if let Some(k_fd) = &out.k_fd {
+        s.push('\n');
+        let xyz = &cl[..3];
+        s.push_str(&matrix("K_fd = K_x[0:3, 0:3] (N/m):", k_fd, Fmt::Fixed(3), xyz, xyz));
+    }
+    s.push('\n');
+    s.push_str(&matrix("C_x (m/N, rad/(N m)):", &out.c_x, Fmt::Sci(4), &cl, &cl));
+    s
+}
