@@ -213,3 +213,33 @@ fn every_text_file_of_the_report_is_committed() {
         assert_committed(name, text);
     }
 }
+
+/// E5 (beyond the paper): the planner at E4's pose. Besides the snapshots, what the section
+/// claims: the least stable total tension is below the paper's case (d) (the decoupled paper
+/// baseline (a) is unstable, the planned one is not); at (d)'s total the planned rows are at
+/// least as stiff as (d) in their objective; the trade-off never falls as the budget grows.
+#[test]
+fn e5_planned_tensions() {
+    let r = report();
+    for e5 in [&r.e5_decoupled, &r.e5_routed] {
+        let rendered = paper::render_e5(e5);
+        insta::assert_snapshot!(format!("e5_{}", e5.model), rendered);
+        assert_committed(&format!("e5_{}.md", e5.model), &rendered);
+        let [a, _, _, d, least, along, softest] = e5.rows.as_slice() else {
+            panic!("seven rows: {:?}", e5.rows);
+        };
+        assert!(least.margin >= paper::E5_MARGIN * (1.0 - 1e-9), "{}", e5.model);
+        assert!(least.total <= d.total, "{}", e5.model);
+        if a.margin < 0.0 {
+            assert!(least.total > a.total, "{}: stability costs tension", e5.model);
+        }
+        let slack = |row: &paper::E5Row| row.gap.unwrap_or(0.0) + 1e-9;
+        assert!(along.k_load.unwrap() >= d.k_load.unwrap() - slack(along), "{}", e5.model);
+        assert!(softest.k_min.unwrap() >= d.k_min.unwrap() - slack(softest), "{}", e5.model);
+        assert!(along.total <= d.total * (1.0 + 1e-12) && softest.total <= d.total * (1.0 + 1e-12));
+        for w in e5.tradeoff.windows(2) {
+            assert!(w[1].1 >= w[0].1 - w[0].2 - w[1].2 - 1e-9, "{}: {:?}", e5.model, e5.tradeoff);
+        }
+    }
+    insta::assert_snapshot!("e5_tradeoff", paper::e5_csv(&[&r.e5_decoupled, &r.e5_routed]));
+}

@@ -62,3 +62,10 @@ pub const E4_CASES: [(&str, [bool; 5]); 4] = [
     ("(c) joint 5 at its highest level", [false, false, false, false, true]),
     ("(d) joints 3 and 5 at their highest levels", [false, false, true, false, true]),
 ];
+
+/// E5's stability margin (beyond the paper): the planned tensions keep the smallest eigenvalue
+/// of `K_q + K_W` at least this, N m/rad.
+pub const E5_MARGIN: f64 = 0.05;
+
+/// Points of E5's trade-off between the tension budget and the best `λ_min(K_fd)`.
+pub const E5_TRADEOFF_POINTS: usize = 9;

@@ -13,6 +13,7 @@ mod arm;
 mod claims;
 mod experiments;
 mod patterns;
+mod planning;
 mod report;
 mod single_joint;
 mod table1;
@@ -24,13 +25,17 @@ pub use arm::{
 pub use claims::{Claim, claims_e1_e3, render_claims};
 pub use experiments::{
     E2_Q, E2_SAMPLES, E2_TORQUE, E3_POINTS, E3_RANGE, E3_TORQUE, E4_CASES, E4_F0,
-    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, PAPER_TABLE_2, SINGLE_JOINT, TABLE_2_TORQUE,
+    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, PAPER_TABLE_2,
+    SINGLE_JOINT, TABLE_2_TORQUE,
 };
 pub use patterns::{
     LEAST_RANGE_AWAY, MAX_RISE, MAX_RISE_OVER_MIN_MOVE, NEAR_ZERO_MAX, NEAR_ZERO_SHARE,
     WIDER_Q2_NEGATIVE, WIDER_Q2_POSITIVE, table_2_patterns,
 };
-pub use report::{FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, Report};
+pub use planning::{E5, E5Row, e5, e5_csv, render_e5};
+pub use report::{
+    FIG_E5_FILE, FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, Report,
+};
 pub use single_joint::{
     E2Point, Table2Row, e2, e2_csv, e3, e3_csv, e3_with_progress, render_table_2,
     rms_relative_error, table_2,

@@ -12,7 +12,8 @@ use crate::routing::Routing;
 
 use super::arm::{E4, claims_e4_end, claims_e4_joints, e4, render_e4, render_routed_vs_decoupled};
 use super::claims::{Claim, claims_e1_e3, render_claims};
-use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE};
+use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE, E5_MARGIN};
+use super::planning::{E5, e5, e5_csv, render_e5};
 use super::single_joint::{
     E2Point, Table2Row, e2, e2_csv, e3_csv, e3_with_progress, render_table_2, table_2,
 };
@@ -27,6 +28,8 @@ pub const REPORT_DIR: &str = "docs/reproduction";
 pub const FIG4_FILE: &str = "fig4_e2.svg";
 /// Fig. 6's file (line plots: SVG).
 pub const FIG6_FILE: &str = "fig6_e4.svg";
+/// E5's trade-off figure (line plots: SVG).
+pub const FIG_E5_FILE: &str = "fig_e5_tradeoff.svg";
 
 /// One heat map of Fig. 5: its file, its title and the number of a sweep cell it shows.
 #[derive(Debug, Clone, Copy)]
@@ -92,6 +95,10 @@ pub struct Report {
     /// The conclusions (1)–(3) on E4: (1) and (2) for the decoupled and the routed runs, (3)
     /// for every run.
     pub claims_e4: Vec<Claim>,
+    /// E5 (beyond the paper), the decoupled model: planned tensions at E4's pose.
+    pub e5_decoupled: E5,
+    /// E5, the routed model.
+    pub e5_routed: E5,
 }
 
 /// The E4 runs with their report file and heading, in the report's order.
@@ -138,6 +145,8 @@ impl Report {
             .flat_map(claims_e4_joints)
             .chain([&e4_decoupled, &e4_routed, &e4_stable].into_iter().flat_map(claims_e4_end))
             .collect();
+        let e5_decoupled = e5(&robot, &routing, "decoupled")?;
+        let e5_routed = e5(&robot, &routed, "routed")?;
         Ok(Report {
             robot,
             routing,
@@ -151,6 +160,8 @@ impl Report {
             e4_routed,
             e4_stable,
             claims_e4,
+            e5_decoupled,
+            e5_routed,
         })
     }
 
@@ -177,6 +188,9 @@ impl Report {
         for ((file, _), run) in E4_RUNS.iter().zip(self.e4_runs()) {
             files.push((file, render_e4(run)));
         }
+        files.push(("e5_decoupled.md", render_e5(&self.e5_decoupled)));
+        files.push(("e5_routed.md", render_e5(&self.e5_routed)));
+        files.push(("e5_tradeoff.csv", e5_csv(&[&self.e5_decoupled, &self.e5_routed])));
         files.push(("README.md", self.readme()));
         files
     }
@@ -247,6 +261,17 @@ impl Report {
             "## Routed beside decoupled (beyond the paper)\n\n{}",
             render_routed_vs_decoupled(&self.e4_decoupled, &self.e4_routed)
         )?;
-        writeln!(r, "## The paper's conclusions on E4\n\n{}", render_claims(&self.claims_e4))
+        writeln!(r, "## The paper's conclusions on E4\n\n{}", render_claims(&self.claims_e4))?;
+        writeln!(r, "## E5 (beyond the paper): planned tensions at E4's pose\n")?;
+        writeln!(
+            r,
+            "The paper chooses tension levels by hand; `sinew-planner` chooses the tensions that optimise the end stiffness, with equilibrium exact, every tension in [20, 600] N and the arm stable (smallest eigenvalue of K_q + K_W ≥ {E5_MARGIN} N m/rad), each answer certified by a gap (the true optimum is at most that much better). Same pose and load as E4; the paper's cases (a)–(d) with the other joints at their lowest level, for comparison. \"Σf of (d)\": the planned rows may use no more total tension than case (d).\n"
+        )?;
+        writeln!(r, "### Decoupled\n\n{}", render_e5(&self.e5_decoupled))?;
+        writeln!(r, "### Routed\n\n{}", render_e5(&self.e5_routed))?;
+        writeln!(
+            r,
+            "The best λ_min(K_fd) against the tension budget (data: `e5_tradeoff.csv`):\n\n![E5 trade-off]({FIG_E5_FILE})"
+        )
     }
 }

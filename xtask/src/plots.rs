@@ -69,6 +69,45 @@ pub fn fig4(points: &[E2Point], path: &Path) -> DynResult<()> {
     Ok(())
 }
 
+/// E5: the best `λ_min(K_fd)` against the tension budget, one line per model.
+pub fn fig_e5(runs: &[&sinew::paper::E5], path: &Path) -> DynResult<()> {
+    let root = SVGBackend::new(path, (700, 450)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let points = runs.iter().flat_map(|e| e.tradeoff.iter());
+    let (mut b0, mut b1, mut v1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64);
+    for &(b, v, _) in points {
+        (b0, b1, v1) = (b0.min(b), b1.max(b), v1.max(v));
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption("E5: the stiffest softest direction for a tension budget", ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(b0..b1, 0.0..v1 * 1.1)?;
+    chart
+        .configure_mesh()
+        .x_desc("tension budget Σf (N)")
+        .y_desc("best λ_min(K_fd) (N/m)")
+        .draw()?;
+    for (e, colour) in runs.iter().zip([RED, BLUE]) {
+        chart
+            .draw_series(LineSeries::new(
+                e.tradeoff.iter().map(|&(b, v, _)| (b, v)),
+                colour.stroke_width(2),
+            ))?
+            .label(e.model.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        chart.draw_series(
+            e.tradeoff.iter().map(|&(b, v, _)| Circle::new((b, v), 3, colour.filled())),
+        )?;
+    }
+    chart.configure_series_labels().border_style(BLACK).background_style(WHITE).draw()?;
+    root.present()?;
+    Ok(())
+}
+
 /// One heat map of Fig. 5 with its colour bar, `value(cell)` over `q1` (x) and `q2` (y), as a
 /// PNG drawn pixel by pixel: each grid cell a [`CELL`] × [`CELL`] square (grey where the
 /// torque cannot be held), the axes with ticks, and the text in an 8 × 8 bitmap font (the

@@ -1,1 +1,73 @@
-fn main() {}
+//! `cargo bench -p sinew-planner`: a certified plan (relative gap 1e-6) on cdhrm5 at the loaded
+//! pose under 5 N along y (both models, every objective; target ≤ 5 ms) and on a 25-joint
+//! decoupled chain (50 DOF, weightless, 0.2 N at the tip; target ≤ 100 ms). Prints each
+//! plan's iterations once, for the time per iteration.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::{Vector3, Vector6};
+use sinew_planner::{Objective, PlanSettings, Planner, PlannerData, Requirements};
+use sinew_routing::PatternModel;
+use sinew_stiffness::ArmStiffness;
+use sinew_testkit::cdhrm5;
+
+fn objectives() -> [Objective; 5] {
+    [
+        Objective::StiffnessAlong(Vector3::y()),
+        Objective::ComplianceAlong(Vector3::y()),
+        Objective::MinStiffness,
+        Objective::Volume,
+        Objective::LeastTension,
+    ]
+}
+
+fn bench_plans(c: &mut Criterion) {
+    let mut group = c.benchmark_group("plan");
+    group.sample_size(20);
+    let settings = PlanSettings::default();
+    let requirements = Requirements::default();
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        let mut data = PlannerData::new(&planner);
+        let q = cdhrm5::LOADED_POSE;
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        let name = if model == PatternModel::Decoupled { "decoupled" } else { "routed" };
+        for objective in objectives() {
+            let plan =
+                planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+            println!("cdhrm5 {name} {}: {} iterations", objective.name(), plan.iterations);
+            group.bench_function(format!("cdhrm5 {name} {}", objective.name()), |b| {
+                b.iter(|| {
+                    planner
+                        .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
+                        .unwrap()
+                })
+            });
+        }
+    }
+    let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
+    let robot = robot.with_gravity(Vector3::zeros());
+    let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+    let mut data = PlannerData::new(&planner);
+    let q: Vec<f64> = (0..50).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+    let f0 = Vector6::new(0.0, 0.2, 0.1, 0.0, 0.0, 0.0);
+    group.sample_size(10);
+    for objective in [Objective::StiffnessAlong(Vector3::y()), Objective::MinStiffness] {
+        let plan = planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+        println!("chain 25 decoupled {}: {} iterations", objective.name(), plan.iterations);
+        group.bench_function(format!("chain 25 decoupled {}", objective.name()), |b| {
+            b.iter(|| {
+                planner
+                    .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
+                    .unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_plans);
+criterion_main!(benches);
