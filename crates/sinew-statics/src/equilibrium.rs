@@ -324,7 +324,7 @@ impl EquilibriumSet {
 
     /// Whether the cables are in force closure at this pose: some strictly positive tension
     /// vector in `null(J_cᵀ)` (every torque can then be held with high enough tensions). One
-    /// small LP ([`crate::policy`]); a property, not a condition of feasibility.
+    /// small LP (solved with clarabel); a property, not a condition of feasibility.
     ///
     /// # Errors
     /// [`StaticsError::Solver`] when the LP solver fails.
