@@ -171,7 +171,8 @@ fn planner_kind(e: &PlanError) -> ErrorKind {
         // No tensions meet what was asked: an answer of the model, like an infeasible load.
         PlanError::NoStableTensions { .. }
         | PlanError::RequirementUnreachable { .. }
-        | PlanError::BudgetTooSmall { .. } => ErrorKind::Infeasible,
+        | PlanError::BudgetTooSmall { .. }
+        | PlanError::BudgetsInfeasible => ErrorKind::Infeasible,
         PlanError::NoEndStiffness => ErrorKind::RankDeficient,
         PlanError::NonConservativeLoad { .. } | PlanError::InvalidInput { .. } => ErrorKind::Input,
         PlanError::Statics(e) => statics_kind(e),

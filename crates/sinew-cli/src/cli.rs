@@ -279,6 +279,10 @@ pub struct PlanArgs {
     /// Total tension at most this (N).
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub budget: Option<String>,
+    /// The tensions of joint J's own cables sum to at most N (joints numbered from 1);
+    /// repeat for several joints.
+    #[arg(long, value_name = "J:N", allow_hyphen_values = true)]
+    pub joint_budget: Vec<String>,
     /// Stop when the certified gap is at most this fraction of the value (default 1e-6).
     #[arg(long, value_name = "REL", allow_hyphen_values = true)]
     pub gap: Option<String>,

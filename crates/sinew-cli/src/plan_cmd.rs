@@ -29,6 +29,8 @@ struct PlanOut {
     k_des: Option<Rows>,
     margin: f64,
     budget: Option<f64>,
+    /// `[[joint (0-based), N], …]`.
+    joint_budgets: Vec<(usize, f64)>,
     /// The relative gap asked for.
     tolerance: f64,
     value: f64,
@@ -94,7 +96,22 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         }
         None => None,
     };
+    let mut joint_budgets = Vec::new();
+    for text in &args.joint_budget {
+        let parsed = text.split_once(':').and_then(|(j, b)| {
+            Some((j.trim().parse::<usize>().ok()?, b.trim().parse::<f64>().ok()?))
+        });
+        match parsed {
+            Some((j, b)) if j >= 1 => joint_budgets.push((j - 1, b)),
+            _ => {
+                return Err(CliError::input(format!(
+                    "--joint-budget {text}: expected J:N, a joint numbered from 1 and a total tension in N"
+                )));
+            }
+        }
+    }
     let requirements = Requirements {
+        joint_budgets,
         margin: args
             .margin
             .as_deref()
@@ -132,6 +149,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         k_des: requirements.k_des.map(|k| na_rows(&k)),
         margin: requirements.margin,
         budget: requirements.budget,
+        joint_budgets: requirements.joint_budgets.clone(),
         tolerance,
         value: plan.value,
         gap: plan.gap,

@@ -60,6 +60,21 @@ pub(crate) struct Linear {
     pub(crate) rhs: Vec<f64>,
 }
 
+impl Linear {
+    /// Whether `x` meets every row (to `1e-9` of the row's scale).
+    pub(crate) fn satisfied(&self, x: &[f64]) -> bool {
+        self.rows.iter().zip(&self.rhs).all(|(row, rhs)| {
+            let scale = rhs.abs().max(row.iter().fold(0.0_f64, |a, v| a.max(v.abs()))).max(1.0);
+            dot(row, x) <= rhs + 1e-9 * scale
+        })
+    }
+}
+
+/// A point meeting the linear rows (the LP with no cut), `None` when there is none.
+pub(crate) fn feasible_point(k: usize, linear: &Linear) -> Result<Option<Vec<f64>>, PlanError> {
+    Ok(upper_bound(k, &[], &[], linear)?.map(|(_, x)| x))
+}
+
 /// How a run ended.
 #[derive(Debug, Clone)]
 pub(crate) enum Outcome {
@@ -99,7 +114,7 @@ pub(crate) fn maximise(
     let mut best: Option<(Vec<f64>, f64)> = None;
     let mut centre = start.to_vec();
     let first = evaluate(start)?;
-    record(&first, start, &mut objective_cuts, &mut constraint_cuts, &mut best);
+    record(&first, start, linear, &mut objective_cuts, &mut constraint_cuts, &mut best);
     for iteration in 1..=settings.max_iterations {
         if let (Some(target), Some((lambda, value))) = (settings.target, &best)
             && *value >= target
@@ -135,7 +150,7 @@ pub(crate) fn maximise(
             None => upper_point,
         };
         let evaluation = evaluate(&next)?;
-        record(&evaluation, &next, &mut objective_cuts, &mut constraint_cuts, &mut best);
+        record(&evaluation, &next, linear, &mut objective_cuts, &mut constraint_cuts, &mut best);
     }
     let Some((lambda, value)) = best else {
         return Ok(Outcome::Infeasible);
@@ -157,6 +172,7 @@ pub(crate) fn maximise(
 fn record(
     evaluation: &Evaluation,
     at: &[f64],
+    linear: &Linear,
     objective_cuts: &mut Vec<Cut>,
     constraint_cuts: &mut Vec<(Cut, f64)>,
     best: &mut Option<(Vec<f64>, f64)>,
@@ -165,7 +181,7 @@ fn record(
         objective_cuts.push(cut.clone());
     }
     constraint_cuts.extend(evaluation.constraints.iter().cloned());
-    if evaluation.feasible() {
+    if evaluation.feasible() && linear.satisfied(at) {
         let value = evaluation.objective.as_ref().map_or(f64::NEG_INFINITY, |c| c.value);
         if best.as_ref().is_none_or(|(_, b)| value > *b) {
             *best = Some((at.to_vec(), value));

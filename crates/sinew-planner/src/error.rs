@@ -50,6 +50,9 @@ pub enum PlanError {
         /// The least total tension, N.
         least: f64,
     },
+    /// No tensions within the limits meet the per-joint budgets (and the total budget).
+    #[error("no tensions within the limits that balance the load meet the per-joint budgets")]
+    BudgetsInfeasible,
     /// The required stiffness cannot be reached within the constraints.
     #[error(
         "the required {what} {} exceeds the best reachable, at most {} (the tension limits, budget and margin allow no more)",

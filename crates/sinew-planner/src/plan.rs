@@ -53,11 +53,20 @@ pub struct Requirements {
     pub k_min: Option<f64>,
     /// `K_fd ⪰ K_des` (symmetric positive definite), N/m.
     pub k_des: Option<Matrix3<f64>>,
+    /// Per-joint budgets `(joint, B)`: the tensions of the cables that drive `joint`
+    /// (0-based, [`sinew_routing::Routing::cables_of_joint`]) sum to at most `B`, N.
+    pub joint_budgets: Vec<(usize, f64)>,
 }
 
 impl Default for Requirements {
     fn default() -> Self {
-        Requirements { margin: DEFAULT_MARGIN, budget: None, k_min: None, k_des: None }
+        Requirements {
+            margin: DEFAULT_MARGIN,
+            budget: None,
+            k_min: None,
+            k_des: None,
+            joint_budgets: Vec::new(),
+        }
     }
 }
 
@@ -168,6 +177,13 @@ impl Planner {
     ) -> Result<Plan, PlanError> {
         check_inputs(f0, objective, requirements, settings)?;
         let arm = &self.arm;
+        let joints = arm.routing().joint_count();
+        if let Some(&(joint, _)) = requirements.joint_budgets.iter().find(|(j, _)| *j >= joints) {
+            return Err(PlanError::InvalidInput {
+                what: "joint_budget",
+                problem: format!("joint {} does not exist: the arm has {joints} joints", joint + 1),
+            });
+        }
         let sd = &mut data.stiffness;
         // The least-total tensions: geometry, T0, K_W at the pose, and whether any tensions
         // balance the load (a typed infeasibility naming the joint otherwise).
@@ -182,7 +198,7 @@ impl Planner {
         }
         let pencil = self.pencil(sd, &set)?;
         let k = set.dimension();
-        let linear = linear_rows(&set, requirements.budget);
+        let linear = linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
         // A start inside the limits (and the budget): the safest tensions when within the
         // budget, else the least-total ones.
         arm.joint_level_with(sd, q, f0, TensionChoice::Policy(TensionPolicy::Safest))?;
@@ -191,6 +207,12 @@ impl Planner {
         let start = match requirements.budget {
             Some(b) if safest_total > b => least_total_lambda,
             _ => safest_lambda,
+        };
+        // Per-joint budgets: a start meeting them too, or the proof that none does.
+        let start = if linear.satisfied(&start) {
+            start
+        } else {
+            bundle::feasible_point(k, &linear)?.ok_or(PlanError::BudgetsInfeasible)?
         };
         let total_of = |lambda: &[f64]| -> f64 {
             let s = column_sums(&set);
@@ -434,6 +456,12 @@ impl Planner {
         })
     }
 
+    /// Each per-joint budget as `(cables of the joint, B)`.
+    fn joint_budget_rows(&self, requirements: &Requirements) -> Vec<(std::ops::Range<usize>, f64)> {
+        let routing = self.arm.routing();
+        requirements.joint_budgets.iter().map(|&(j, b)| (routing.cables_of_joint(j), b)).collect()
+    }
+
     /// `A_0` and the `A_i` at the last joint-level evaluation in `sd`.
     fn pencil(&self, sd: &mut ArmStiffnessData, set: &EquilibriumSet) -> Result<Pencil, PlanError> {
         let routing = self.arm.routing();
@@ -494,6 +522,9 @@ fn check_inputs(
     {
         return bad("k_min", "must be finite");
     }
+    if requirements.joint_budgets.iter().any(|(_, b)| !(b.is_finite() && *b >= 0.0)) {
+        return bad("joint_budget", "must be finite and ≥ 0 N");
+    }
     if let Some(k) = requirements.k_des {
         let symmetric = (k - k.transpose()).abs().max() <= 1e-9 * k.abs().max().max(1.0);
         if !(k.iter().all(|v| v.is_finite()) && symmetric && k.cholesky().is_some()) {
@@ -512,8 +543,13 @@ fn column_sums(set: &EquilibriumSet) -> Vec<f64> {
     (0..set.dimension()).map(|i| (0..set.cable_count()).map(|c| null[(c, i)]).sum()).collect()
 }
 
-/// The limits `f_min ≤ f_p + N λ ≤ f_max` and the budget `Σ f ≤ B` as rows in `λ`.
-fn linear_rows(set: &EquilibriumSet, budget: Option<f64>) -> Linear {
+/// The limits `f_min ≤ f_p + N λ ≤ f_max`, the budget `Σ f ≤ B` and the per-joint budgets
+/// `Σ_{c ∈ cables} f_c ≤ B_j` as rows in `λ`.
+fn linear_rows(
+    set: &EquilibriumSet,
+    budget: Option<f64>,
+    joint_budgets: &[(std::ops::Range<usize>, f64)],
+) -> Linear {
     let null = set.null_basis();
     let (m, k) = (set.cable_count(), set.dimension());
     let p = set.particular();
@@ -528,6 +564,10 @@ fn linear_rows(set: &EquilibriumSet, budget: Option<f64>) -> Linear {
     if let Some(b) = budget {
         linear.rows.push(column_sums(set));
         linear.rhs.push(b - p.iter().sum::<f64>());
+    }
+    for (cables, b) in joint_budgets {
+        linear.rows.push((0..k).map(|i| cables.clone().map(|c| null[(c, i)]).sum()).collect());
+        linear.rhs.push(b - cables.clone().map(|c| p[c]).sum::<f64>());
     }
     linear
 }

@@ -590,3 +590,37 @@ fn bad_input_and_unreachable_requirements_are_typed() {
     assert!(k_fd.symmetric_eigen().eigenvalues.min() >= 0.5 * best.value * (1.0 - 1e-9));
     assert!((cheap.value - cheap.total_tension).abs() <= 1e-9 * cheap.value);
 }
+
+#[test]
+fn a_binding_joint_budget_is_met_with_equality() {
+    let case = cdhrm5_case(PatternModel::Decoupled);
+    let planner = case.planner();
+    let mut pdata = PlannerData::new(&planner);
+    let objective = Objective::StiffnessAlong(Vector3::y());
+    let free = planner
+        .plan(
+            &mut pdata,
+            &case.q,
+            &case.f0,
+            objective,
+            &Requirements::default(),
+            &PlanSettings::default(),
+        )
+        .unwrap();
+    let own = case.routing.cables_of_joint(4);
+    let sum = |plan: &Plan| plan.tensions[own.clone()].iter().sum::<f64>();
+    let cap = 0.6 * sum(&free);
+    let bound = Requirements { joint_budgets: vec![(4, cap)], ..Requirements::default() };
+    let plan = planner
+        .plan(&mut pdata, &case.q, &case.f0, objective, &bound, &PlanSettings::default())
+        .unwrap();
+    assert!(sum(&plan) <= cap * (1.0 + 1e-12), "{} > {cap}", sum(&plan));
+    assert!(sum(&plan) >= cap * (1.0 - 1e-4), "binding: {} of {cap}", sum(&plan));
+    assert!(plan.value <= free.value + free.gap);
+    // Below joint 5's least sum: refused.
+    let impossible = Requirements { joint_budgets: vec![(4, 1.0)], ..Requirements::default() };
+    let err = planner
+        .plan(&mut pdata, &case.q, &case.f0, objective, &impossible, &PlanSettings::default())
+        .unwrap_err();
+    assert!(matches!(err, PlanError::BudgetsInfeasible), "{err}");
+}
