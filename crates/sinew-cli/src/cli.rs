@@ -283,6 +283,10 @@ pub struct PlanArgs {
     /// repeat for several joints.
     #[arg(long, value_name = "J:N", allow_hyphen_values = true)]
     pub joint_budget: Vec<String>,
+    /// Hold joint J at tension level S in [0, 1] (joints numbered from 1; the paper's levels,
+    /// decoupled model); repeatable.
+    #[arg(long, value_name = "J:S", allow_hyphen_values = true)]
+    pub fixed_level: Vec<String>,
     /// Stop when the certified gap is at most this fraction of the value (default 1e-6).
     #[arg(long, value_name = "REL", allow_hyphen_values = true)]
     pub gap: Option<String>,

@@ -31,6 +31,8 @@ struct PlanOut {
     budget: Option<f64>,
     /// `[[joint (0-based), N], …]`.
     joint_budgets: Vec<(usize, f64)>,
+    /// `[[joint (0-based), level], …]`.
+    fixed_levels: Vec<(usize, f64)>,
     /// The relative gap asked for.
     tolerance: f64,
     value: f64,
@@ -45,6 +47,26 @@ struct PlanOut {
     min_eigenvalue: f64,
     stable: bool,
     iterations: usize,
+}
+
+/// `J:X` pairs, joints numbered from 1 on the command line, 0-based in the library.
+fn joint_pairs(
+    option: &str,
+    texts: &[String],
+    expected: &str,
+) -> Result<Vec<(usize, f64)>, CliError> {
+    texts
+        .iter()
+        .map(|text| {
+            let parsed = text.split_once(':').and_then(|(j, x)| {
+                Some((j.trim().parse::<usize>().ok()?, x.trim().parse::<f64>().ok()?))
+            });
+            match parsed {
+                Some((j, x)) if j >= 1 => Ok((j - 1, x)),
+                _ => Err(CliError::input(format!("{option} {text}: expected {expected}"))),
+            }
+        })
+        .collect()
 }
 
 fn one_number(option: &str, text: &str) -> Result<f64, CliError> {
@@ -96,22 +118,19 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let mut joint_budgets = Vec::new();
-    for text in &args.joint_budget {
-        let parsed = text.split_once(':').and_then(|(j, b)| {
-            Some((j.trim().parse::<usize>().ok()?, b.trim().parse::<f64>().ok()?))
-        });
-        match parsed {
-            Some((j, b)) if j >= 1 => joint_budgets.push((j - 1, b)),
-            _ => {
-                return Err(CliError::input(format!(
-                    "--joint-budget {text}: expected J:N, a joint numbered from 1 and a total tension in N"
-                )));
-            }
-        }
-    }
+    let joint_budgets = joint_pairs(
+        "--joint-budget",
+        &args.joint_budget,
+        "J:N, a joint numbered from 1 and a total tension in N",
+    )?;
+    let fixed_levels = joint_pairs(
+        "--fixed-level",
+        &args.fixed_level,
+        "J:S, a joint numbered from 1 and a level in [0, 1]",
+    )?;
     let requirements = Requirements {
         joint_budgets,
+        fixed_levels,
         margin: args
             .margin
             .as_deref()
@@ -150,6 +169,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         margin: requirements.margin,
         budget: requirements.budget,
         joint_budgets: requirements.joint_budgets.clone(),
+        fixed_levels: requirements.fixed_levels.clone(),
         tolerance,
         value: plan.value,
         gap: plan.gap,

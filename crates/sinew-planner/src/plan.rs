@@ -56,6 +56,10 @@ pub struct Requirements {
     /// Per-joint budgets `(joint, B)`: the tensions of the cables that drive `joint`
     /// (0-based, [`sinew_routing::Routing::cables_of_joint`]) sum to at most `B`, N.
     pub joint_budgets: Vec<(usize, f64)>,
+    /// Joints held at a given tension level `(joint, s)`, `s ∈ [0, 1]` (the paper's levels: the
+    /// closed form, decoupled model only: there a joint's own tensions at a level do not depend
+    /// on the others).
+    pub fixed_levels: Vec<(usize, f64)>,
 }
 
 impl Default for Requirements {
@@ -66,6 +70,7 @@ impl Default for Requirements {
             k_min: None,
             k_des: None,
             joint_budgets: Vec::new(),
+            fixed_levels: Vec::new(),
         }
     }
 }
@@ -185,6 +190,7 @@ impl Planner {
             });
         }
         let sd = &mut data.stiffness;
+        let fixed = self.fixed_tensions(sd, q, f0, requirements)?;
         // The least-total tensions: geometry, T0, K_W at the pose, and whether any tensions
         // balance the load (a typed infeasibility naming the joint otherwise).
         arm.joint_level_with(sd, q, f0, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
@@ -198,7 +204,9 @@ impl Planner {
         }
         let pencil = self.pencil(sd, &set)?;
         let k = set.dimension();
-        let linear = linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
+        let mut linear =
+            linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
+        fix_rows(&set, &fixed, &mut linear);
         // A start inside the limits (and the budget): the safest tensions when within the
         // budget, else the least-total ones.
         arm.joint_level_with(sd, q, f0, TensionChoice::Policy(TensionPolicy::Safest))?;
@@ -456,6 +464,50 @@ impl Planner {
         })
     }
 
+    /// The own tensions of every joint held at a level: `(cables, tensions)`.
+    fn fixed_tensions(
+        &self,
+        sd: &mut ArmStiffnessData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+        requirements: &Requirements,
+    ) -> Result<Vec<(std::ops::Range<usize>, Vec<f64>)>, PlanError> {
+        if requirements.fixed_levels.is_empty() {
+            return Ok(Vec::new());
+        }
+        let arm = &self.arm;
+        let joints = arm.routing().joint_count();
+        if !(arm.statics().has_levels() && arm.routing().is_decoupled()) {
+            return Err(PlanError::InvalidInput {
+                what: "fixed_level",
+                problem: "fixed tension levels need the paper's closed form in the decoupled model (three cables per universal joint, each crossing only its joint)".into(),
+            });
+        }
+        let mut levels = vec![0.0; joints];
+        for &(joint, s) in &requirements.fixed_levels {
+            if joint >= joints || !(0.0..=1.0).contains(&s) {
+                return Err(PlanError::InvalidInput {
+                    what: "fixed_level",
+                    problem: format!(
+                        "joint {} at level {s}: joints are 1 to {joints}, levels in [0, 1]",
+                        joint + 1
+                    ),
+                });
+            }
+            levels[joint] = s;
+        }
+        arm.joint_level(sd, q, f0, &levels)?;
+        let routing = arm.routing();
+        Ok(requirements
+            .fixed_levels
+            .iter()
+            .map(|&(joint, _)| {
+                let cables = routing.cables_of_joint(joint);
+                (cables.clone(), sd.tensions()[cables].to_vec())
+            })
+            .collect())
+    }
+
     /// Each per-joint budget as `(cables of the joint, B)`.
     fn joint_budget_rows(&self, requirements: &Requirements) -> Vec<(std::ops::Range<usize>, f64)> {
         let routing = self.arm.routing();
@@ -570,6 +622,35 @@ fn linear_rows(
         linear.rhs.push(b - cables.clone().map(|c| p[c]).sum::<f64>());
     }
     linear
+}
+
+/// Hold each fixed joint's own tensions: its null coordinate (the one column of `N` on its
+/// cables, decoupled) fixed to the value that gives them, as two rows a rounding apart.
+fn fix_rows(
+    set: &EquilibriumSet,
+    fixed: &[(std::ops::Range<usize>, Vec<f64>)],
+    linear: &mut Linear,
+) {
+    let null = set.null_basis();
+    let k = set.dimension();
+    let p = set.particular();
+    for (cables, target) in fixed {
+        let Some(column) = (0..k).find(|&i| cables.clone().any(|c| null[(c, i)].abs() > 0.5))
+        else {
+            continue;
+        };
+        let value: f64 =
+            cables.clone().zip(target).map(|(c, t)| null[(c, column)] * (t - p[c])).sum();
+        let tol = 1e-9 * (1.0 + value.abs());
+        let mut up = vec![0.0; k];
+        up[column] = 1.0;
+        linear.rows.push(up);
+        linear.rhs.push(value + tol);
+        let mut down = vec![0.0; k];
+        down[column] = -1.0;
+        linear.rows.push(down);
+        linear.rhs.push(tol - value);
+    }
 }
 
 /// A stiffness scale of the pencil (N m/rad), for absolute floors of the gaps.

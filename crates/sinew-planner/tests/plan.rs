@@ -624,3 +624,36 @@ fn a_binding_joint_budget_is_met_with_equality() {
         .unwrap_err();
     assert!(matches!(err, PlanError::BudgetsInfeasible), "{err}");
 }
+
+#[test]
+fn fixed_levels_are_held_and_need_the_decoupled_closed_form() {
+    let case = cdhrm5_case(PatternModel::Decoupled);
+    let planner = case.planner();
+    let mut pdata = PlannerData::new(&planner);
+    let objective = Objective::MinStiffness;
+    let s = PlanSettings::default();
+    let free = planner
+        .plan(&mut pdata, &case.q, &case.f0, objective, &Requirements::default(), &s)
+        .unwrap();
+    let held = Requirements { fixed_levels: vec![(2, 0.25), (4, 1.0)], ..Requirements::default() };
+    let plan = planner.plan(&mut pdata, &case.q, &case.f0, objective, &held, &s).unwrap();
+    let levels = plan.levels.clone().unwrap();
+    assert!((levels[2] - 0.25).abs() <= 1e-6 && (levels[4] - 1.0).abs() <= 1e-6, "{levels:?}");
+    assert!(plan.value <= free.value + free.gap, "holding joints cannot help");
+    // The held joints' tensions are those of the closed form at those levels.
+    let arm = planner.arm();
+    let mut data = ArmStiffnessData::new(arm);
+    let mut at = levels.clone();
+    at[2] = 0.25;
+    at[4] = 1.0;
+    arm.joint_level(&mut data, &case.q, &case.f0, &at).unwrap();
+    for c in case.routing.cables_of_joint(2).chain(case.routing.cables_of_joint(4)) {
+        let (a, b) = (plan.tensions[c], data.tensions()[c]);
+        assert!((a - b).abs() <= 1e-6 * b, "cable {c}: {a} vs {b}");
+    }
+    let routed = cdhrm5_case(PatternModel::Routed);
+    let planner = routed.planner();
+    let mut pdata = PlannerData::new(&planner);
+    let err = planner.plan(&mut pdata, &routed.q, &routed.f0, objective, &held, &s).unwrap_err();
+    assert!(matches!(err, PlanError::InvalidInput { what: "fixed_level", .. }), "{err}");
+}
