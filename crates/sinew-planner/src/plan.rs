@@ -471,7 +471,7 @@ impl Planner {
         q: &[f64],
         f0: &Vector6<f64>,
         requirements: &Requirements,
-    ) -> Result<Vec<(std::ops::Range<usize>, Vec<f64>)>, PlanError> {
+    ) -> Result<Vec<HeldTensions>, PlanError> {
         if requirements.fixed_levels.is_empty() {
             return Ok(Vec::new());
         }
@@ -623,6 +623,9 @@ fn linear_rows(
     }
     linear
 }
+
+/// A joint held at a level: its cables and their tensions there.
+type HeldTensions = (std::ops::Range<usize>, Vec<f64>);
 
 /// Hold each fixed joint's own tensions: its null coordinate (the one column of `N` on its
 /// cables, decoupled) fixed to the value that gives them, as two rows a rounding apart.
