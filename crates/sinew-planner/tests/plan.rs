@@ -343,7 +343,8 @@ fn the_answer_balances_the_load_within_the_limits_and_is_the_pipelines() {
                     &PlanSettings::default(),
                 )
                 .unwrap();
-            // Limits exactly; balance by the statics' own check (1e-9 relative).
+            // The margin asked for; limits exactly; balance (1e-9 relative).
+            assert!(plan.min_eigenvalue >= Requirements::default().margin * (1.0 - 1e-9));
             for (f, [lo, hi]) in plan.tensions.iter().zip(case.routing.cable_limits()) {
                 assert!(lo <= f && f <= hi, "{model:?}: {f} outside [{lo}, {hi}]");
             }
