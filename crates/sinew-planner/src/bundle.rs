@@ -61,6 +61,36 @@ pub(crate) struct Linear {
 }
 
 impl Linear {
+    /// The same polytope with parallel rows merged (the tightest kept): in the decoupled model
+    /// each cable's two limit rows bound the one coordinate of its joint, so three cables'
+    /// six rows become two.
+    pub(crate) fn merged(&self) -> Linear {
+        let mut out = Linear::default();
+        for (row, rhs) in self.rows.iter().zip(&self.rhs) {
+            let scale = row.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            if scale == 0.0 {
+                // 0 ≤ rhs: keep it (an infeasible one proves infeasibility).
+                out.rows.push(row.clone());
+                out.rhs.push(*rhs);
+                continue;
+            }
+            let unit: Vec<f64> = row.iter().map(|v| v / scale).collect();
+            let b = rhs / scale;
+            let same = out
+                .rows
+                .iter()
+                .position(|r| r.iter().zip(&unit).all(|(x, y)| (x - y).abs() <= 1e-12));
+            match same {
+                Some(i) => out.rhs[i] = out.rhs[i].min(b),
+                None => {
+                    out.rows.push(unit);
+                    out.rhs.push(b);
+                }
+            }
+        }
+        out
+    }
+
     /// Whether `x` meets every row (to `1e-9` of the row's scale).
     pub(crate) fn satisfied(&self, x: &[f64]) -> bool {
         self.rows.iter().zip(&self.rhs).all(|(row, rhs)| {

@@ -207,6 +207,7 @@ impl Planner {
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
         fix_rows(&set, &fixed, &mut linear);
+        let linear = linear.merged();
         // A start inside the limits (and the budget): the safest tensions when within the
         // budget, else the least-total ones.
         arm.joint_level_with(sd, q, f0, TensionChoice::Policy(TensionPolicy::Safest))?;
