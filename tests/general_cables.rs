@@ -643,3 +643,47 @@ fn a_joint_without_force_closure_is_answered_when_its_segment_is_not_empty() {
         assert_one_sentence(&message);
     }
 }
+
+/// The two routing examples of docs/cli.md load as they say: four cables on one universal
+/// joint (a two-dimensional equilibrium set), and a revolute joint beside a universal joint
+/// with a shared cable of its own limits.
+#[test]
+fn the_routing_examples_of_the_cli_docs_load() {
+    let doc = std::fs::read_to_string(cdhrm5::workspace_root().join("docs/cli.md")).unwrap();
+    let blocks: Vec<&str> =
+        doc.split("```toml\n").skip(1).map(|b| b.split("```").next().unwrap()).collect();
+    let four = blocks.iter().find(|b| b.contains("\"j1d\"")).expect("the 4-cable example");
+    let robot = cdhrm5::chain_robot(1);
+    let routing = Routing::from_toml_str(four, "cli.md", &robot).unwrap();
+    assert_eq!(routing.cable_joints(), &[0, 0, 0, 0]);
+    let choice = TensionChoice::Policy(TensionPolicy::LeastNorm);
+    let (statics, cables, data) =
+        statics_at(&robot, &routing, &[0.1, -0.2], &Vector6::zeros(), choice);
+    let set = statics.equilibrium_set(&cables, &data.unwrap()).unwrap();
+    assert_eq!(set.dimension(), 2);
+
+    let mixed = blocks.iter().find(|b| b.contains("\"shared\"")).expect("the mixed example");
+    let urdf = r#"<robot name="mixed"><link name="base_link"/>
+      <joint name="r" type="revolute"><parent link="base_link"/><child link="link1"/>
+        <origin xyz="0 0 0.03"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <link name="link1"><inertial><origin xyz="0 0 0.1"/><mass value="0.2"/>
+        <inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-4"/></inertial></link>
+      <joint name="link1_disc" type="fixed"><parent link="link1"/><child link="link1_distal"/><origin xyz="0 0 0.2"/></joint>
+      <link name="link1_distal"/>
+      <joint name="u_x" type="revolute"><parent link="link1_distal"/><child link="cross2"/>
+        <origin xyz="0 0 0.03"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <link name="cross2"/>
+      <joint name="u_y" type="revolute"><parent link="cross2"/><child link="link2"/>
+        <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <link name="link2"/></robot>"#;
+    let settings = sinew::robot::ChainSettings {
+        tip_link: "link2".to_owned(),
+        gravity: nalgebra::Vector3::zeros(),
+    };
+    let robot = Robot::from_urdf_str(urdf, "mixed.urdf", &settings).unwrap();
+    assert_eq!(robot.joint_groups(), &[0..1, 1..3]);
+    let routing = Routing::from_toml_str(mixed, "cli.md", &robot).unwrap();
+    assert_eq!(routing.cable_joints(), &[0, 0, 1], "the shared cable drives the universal joint");
+    assert_eq!(routing.cable_limits()[2], [10.0, 300.0]);
+    assert_eq!(routing.cable_joint_span(2), Some(0..2), "and crosses both joints");
+}
