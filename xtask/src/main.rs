@@ -3,12 +3,14 @@
 //! - `reproduce [--check]`: every table and figure of the paper, from the robot files in
 //!   `robots/`; `--check` fails when the committed `docs/reproduction/` is stale.
 //! - `gen-chain`: write the URDF of a uniform chain of universal joints.
+//! - `test [--locked]`: `cargo test --workspace`, then the Python bindings' pytest suite.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod calibrate;
 mod plots;
+mod pytest;
 mod reproduce;
 
 type DynResult<T> = Result<T, Box<dyn std::error::Error>>;
@@ -21,6 +23,8 @@ commands:
   gen-chain --joints N --out FILE [--name NAME] [--d1 M] [--d2 M] [--link-length M]
             [--link-radius M] [--mass-per-link KG] [--limit RAD]
                                   write the URDF of a uniform chain of universal joints
+  test [--locked]                 every test: cargo test --workspace, then the Python bindings (a virtualenv in
+                                  target/py-venv, pip install maturin numpy pytest, maturin develop, pytest)
   calibrate [--check]             fit the unstated joint geometry to Table II and write it into robots/cdhrm5";
 
 fn main() -> ExitCode {
@@ -29,6 +33,7 @@ fn main() -> ExitCode {
         Some("reproduce") => reproduce::run(&project_root(), &args[1..]),
         Some("gen-chain") => gen_chain(&args[1..]),
         Some("calibrate") => calibrate::run(&args[1..]),
+        Some("test") => pytest::run(&project_root(), &args[1..]),
         Some("-h" | "--help") | None => {
             println!("{USAGE}");
             Ok(())

@@ -1,0 +1,41 @@
+//! Python bindings of Sinew: `import sinew` (built with maturin; the Python package, its type
+//! stubs and `py.typed` are in `python/sinew/`).
+//!
+//! In the spirit of Pinocchio's: immutable models (`Robot`, `Routing`, `ArmStiffness`) with
+//! their workspaces inside, numpy arrays in and out, SI units, the conventions and joint
+//! numbering of the Rust crates (0-based; joint `i` owns `q[2i]`, `q[2i+1]` when universal).
+//! Errors are Python exceptions (`errors.rs`); nothing a user passes reaches a panic.
+
+use pyo3::prelude::*;
+
+mod arm;
+pub mod batch;
+mod convert;
+mod errors;
+mod indicators;
+mod model;
+
+/// The extension module `sinew._sinew`, re-exported by the `sinew` package.
+#[pymodule]
+fn _sinew(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<model::Robot>()?;
+    m.add_class::<model::Routing>()?;
+    m.add_class::<arm::ArmStiffness>()?;
+    m.add_class::<arm::ArmResult>()?;
+    m.add_class::<arm::BatchResult>()?;
+    m.add_class::<arm::PlanResult>()?;
+    m.add_class::<indicators::JointRange>()?;
+    m.add_class::<indicators::SweepResult>()?;
+    m.add_function(wrap_pyfunction!(model::load_robot, m)?)?;
+    m.add_function(wrap_pyfunction!(model::load_routing, m)?)?;
+    m.add_function(wrap_pyfunction!(indicators::joint_range, m)?)?;
+    m.add_function(wrap_pyfunction!(indicators::sweep, m)?)?;
+    m.add("SinewError", py.get_type::<errors::SinewError>())?;
+    m.add("InputError", py.get_type::<errors::InputError>())?;
+    m.add("InfeasibleError", py.get_type::<errors::InfeasibleError>())?;
+    m.add("UnstableError", py.get_type::<errors::UnstableError>())?;
+    m.add("RankDeficientError", py.get_type::<errors::RankDeficientError>())?;
+    m.add("NumericalError", py.get_type::<errors::NumericalError>())?;
+    Ok(())
+}

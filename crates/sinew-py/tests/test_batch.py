@@ -1,0 +1,89 @@
+"""evaluate_many: each row equals evaluate's, bad rows are flagged, 10 000 configurations."""
+
+import numpy as np
+import pytest
+
+import sinew
+from conftest import E4_F0, E4_Q, close
+
+
+def random_q(robot, n, seed=7):
+    rng = np.random.default_rng(seed)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    return lo + (hi - lo) * rng.random((n, robot.dof)) * 0.5 + (hi - lo) * 0.25
+
+
+def test_rows_equal_evaluate(robot, arm):
+    Q = random_q(robot, 40)
+    Q[0] = E4_Q
+    b = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5)
+    assert len(b) == 40
+    for r in range(40):
+        if not b.ok[r]:
+            with pytest.raises(sinew.SinewError):
+                arm.evaluate(Q[r], E4_F0, levels=[0.5] * 5)
+            continue
+        one = arm.evaluate(Q[r], E4_F0, levels=[0.5] * 5)
+        assert b.stable[r] == one.stable
+        close(b.t0[r], one.t0, 0)
+        close(b.tensions[r], one.tensions, 0)
+        close(b.min_eigenvalue[r], one.min_eigenvalue, 0)
+        if one.stable:
+            close(b.c_x[r], one.c_x, 0)
+            close(b.k_fd[r], one.k_fd, 0)
+        else:
+            assert np.all(np.isnan(b.c_x[r]))
+
+
+def test_bad_rows_are_flagged(robot, arm):
+    Q = np.zeros((4, 10))
+    Q[1, 3] = np.nan
+    Q[2, 0] = 3.0
+    b = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5)
+    assert b.ok.tolist() == [True, False, False, True]
+    assert [e[0] for e in b.errors] == [1, 2]
+    assert [e[1] for e in b.errors] == ["input", "input"]
+    assert b.errors[1][2].startswith("q: ")
+    assert np.all(np.isnan(b.t0[1])) and np.all(np.isnan(b.c_x[2]))
+
+
+def test_all_bad_rows_raise(arm):
+    with pytest.raises(sinew.InputError, match="every row failed"):
+        arm.evaluate_many(np.full((3, 10), 3.0))
+    with pytest.raises(sinew.InfeasibleError, match="every row failed"):
+        arm.evaluate_many(np.tile(E4_Q, (2, 1)), [0, 500, 0, 0, 0, 0])
+    with pytest.raises(sinew.InputError, match=r"shape \(N, 10\)"):
+        arm.evaluate_many(np.zeros((3, 4)))
+    with pytest.raises(sinew.InputError, match="2-D"):
+        arm.evaluate_many(np.zeros(10))
+
+
+def test_empty_batch(arm):
+    b = arm.evaluate_many(np.zeros((0, 10)))
+    assert b.t0.shape == (0, 10) and b.c_x.shape == (0, 6, 6) and b.errors == []
+
+
+def test_ten_thousand_configurations(robot, arm):
+    Q = random_q(robot, 10_000, seed=11)
+    b = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5)
+    n = 10_000
+    assert b.ok.shape == (n,) and b.ok.dtype == np.bool_ and b.stable.dtype == np.bool_
+    assert b.t0.shape == (n, 10) and b.tensions.shape == (n, 15)
+    assert b.c_x.shape == (n, 6, 6) and b.k_x.shape == (n, 6, 6) and b.k_fd.shape == (n, 3, 3)
+    assert b.min_eigenvalue.shape == (n,) and b.min_eigenvalue.dtype == np.float64
+    assert len(b.errors) == int((~b.ok).sum())
+    assert np.isfinite(b.c_x[b.stable]).all()
+    # Spot-check rows against evaluate.
+    for r in [0, 4999, 9999]:
+        if b.ok[r]:
+            close(b.tensions[r], arm.evaluate(Q[r], E4_F0, levels=[0.5] * 5).tensions, 0)
+
+
+def test_policy_batch():
+    from conftest import UA3X4
+    robot = sinew.load_robot(UA3X4)
+    arm = sinew.ArmStiffness(robot, sinew.load_routing(robot))
+    Q = np.array([[0.2, -0.3, 0.25, 0.1, -0.15, 0.3], [0.0] * 6])
+    b = arm.evaluate_many(Q, [0, 2, 0, 0, 0, 0], policy="safest")
+    for r in range(2):
+        close(b.tensions[r], arm.evaluate(Q[r], [0, 2, 0, 0, 0, 0], policy="safest").tensions, 0)
