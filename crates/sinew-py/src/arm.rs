@@ -398,8 +398,9 @@ impl ArmStiffness {
     /// `objective` one of `"stiffness-along"` and `"compliance-along"` (with `direction`),
     /// `"min-stiffness"`, `"volume"`, `"least-tension"`; requirements `k_min` (N/m), `k_des`
     /// (3 × 3, N/m), `margin` (N m/rad), `budget` (N), `joint_budgets` (`{joint: N}`,
-    /// 0-based); `gap` the relative gap at which it stops. The GIL is released while it runs.
-    #[pyo3(signature = (q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, gap = 1e-6))]
+    /// 0-based), `fixed_levels` (`{joint: level}`, 0-based, decoupled model); `gap` the
+    /// relative gap at which it stops. The GIL is released while it runs.
+    #[pyo3(signature = (q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, fixed_levels = None, gap = 1e-6))]
     fn plan<'py>(
         &self,
         py: Python<'py>,
@@ -412,6 +413,7 @@ impl ArmStiffness {
         margin: f64,
         budget: Option<f64>,
         joint_budgets: Option<std::collections::BTreeMap<usize, f64>>,
+        fixed_levels: Option<std::collections::BTreeMap<usize, f64>>,
         gap: f64,
     ) -> PyResult<PlanResult> {
         let arm = &self.arm;
@@ -462,6 +464,7 @@ impl ArmStiffness {
             k_min,
             k_des,
             joint_budgets: joint_budgets.unwrap_or_default().into_iter().collect(),
+            fixed_levels: fixed_levels.unwrap_or_default().into_iter().collect(),
         };
         let settings = PlanSettings { relative_gap: gap, ..PlanSettings::default() };
         let (planner, data) = self.planner.get_or_init(|| {

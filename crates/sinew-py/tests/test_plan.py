@@ -49,3 +49,12 @@ def test_plan_errors(arm):
         arm.plan(E4_Q, E4_F0, "min-stiffness", budget=1.0)
     with pytest.raises(sinew.InputError, match="wrench"):
         arm.plan(E4_Q, [0, 5, 0, 1, 0, 0])
+
+
+def test_plan_fixed_levels_against_the_cli(arm):
+    r = arm.plan(E4_Q, E4_F0, "min-stiffness", fixed_levels={2: 0.25})
+    doc = cli("plan", "--robot", str(CDHRM5), "--q", csv(E4_Q), "--wrench", csv(E4_F0),
+              "--objective", "min-stiffness", "--fixed-level", "3:0.25")
+    close(r.value, doc["value"], 1e-10)
+    close(r.levels, doc["levels"], 1e-10)
+    assert abs(r.levels[2] - 0.25) <= 1e-6

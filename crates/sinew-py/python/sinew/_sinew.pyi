@@ -203,6 +203,7 @@ class ArmStiffness:
         margin: float = 1e-3,
         budget: Optional[float] = None,
         joint_budgets: Optional[Mapping[int, float]] = None,
+        fixed_levels: Optional[Mapping[int, float]] = None,
         gap: float = 1e-6,
     ) -> PlanResult:
         """The tensions that optimise the end stiffness (``sinew plan``)."""
