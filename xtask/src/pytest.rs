@@ -1,8 +1,13 @@
 //! `cargo xtask test [--locked]`: every test of the project in one command. `cargo test
 //! --workspace`, then the Python bindings: a virtualenv in `target/py-venv` (made once; pip
-//! installs maturin, numpy and pytest into it), `maturin develop` (the dev profile, so it
-//! reuses what `cargo test` just built) and pytest on `crates/sinew-py/tests`. pytest's "no
-//! tests collected" (exit 5) fails like any other non-zero exit.
+//! installs numpy and pytest into it), the package assembled in `target/py-pkg/sinew` from
+//! `crates/sinew-py/python/sinew` and the extension module `cargo test` has just built (the
+//! `sinew-py` cdylib, `target/debug/deps/lib_sinew.so`: its example links the library, so the
+//! workspace build makes it with the workspace's features and nothing is compiled again), and
+//! pytest on `crates/sinew-py/tests` with that folder first on `PYTHONPATH`. pytest's "no tests
+//! collected" (exit 5) fails like any other non-zero exit. (Users install the package with
+//! `pip install ./crates/sinew-py` or `maturin develop`; building it with maturin here would
+//! compile the dependencies again with maturin's feature set, about two minutes of CI.)
 
 use std::path::Path;
 use std::process::Command;
@@ -10,8 +15,8 @@ use std::time::Instant;
 
 use crate::DynResult;
 
-/// What pip installs into the virtualenv: the build tool and the tests' dependencies only.
-const PYTHON_PACKAGES: [&str; 3] = ["maturin>=1.9,<2", "numpy", "pytest"];
+/// What pip installs into the virtualenv: the tests' dependencies only.
+const PYTHON_PACKAGES: [&str; 2] = ["numpy", "pytest"];
 
 pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     let mut locked = false;
@@ -46,16 +51,7 @@ pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     let mut paths = vec![bin.clone()];
     paths.extend(std::env::split_paths(&path));
     let path = std::env::join_paths(paths)?;
-    println!("== maturin develop (dev profile) in crates/sinew-py");
-    status(
-        Command::new(bin.join("maturin"))
-            .current_dir(root.join("crates").join("sinew-py"))
-            .args(["develop", "--quiet"])
-            .args(lock)
-            .env("VIRTUAL_ENV", &venv)
-            .env("PATH", &path)
-            .env_remove("CONDA_PREFIX"),
-    )?;
+    let package = assemble_package(root)?;
     println!("== pytest crates/sinew-py/tests");
     // The `sinew` binary the tests compare with: the one `cargo test` built.
     status(
@@ -63,10 +59,46 @@ pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
             .current_dir(root)
             .args(["-m", "pytest", "-q", "crates/sinew-py/tests"])
             .env("SINEW_BIN", root.join("target").join("debug").join("sinew"))
+            .env("PYTHONPATH", &package)
             .env("PATH", &path),
     )?;
     println!("== the Python step took {:.1} s", start.elapsed().as_secs_f64());
     Ok(())
+}
+
+/// `target/py-pkg`: the Python package `sinew` (the sources of `crates/sinew-py/python/sinew`
+/// and the extension module `_sinew` that `cargo test --workspace` built), made afresh.
+fn assemble_package(root: &Path) -> DynResult<std::path::PathBuf> {
+    let built = root.join("target").join("debug").join("deps").join(format!(
+        "{}_sinew{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    if !built.is_file() {
+        return Err(format!(
+            "{}: the sinew-py extension module is missing (cargo test --workspace builds it for its example)",
+            built.display()
+        )
+        .into());
+    }
+    let out = root.join("target").join("py-pkg");
+    let package = out.join("sinew");
+    if package.exists() {
+        std::fs::remove_dir_all(&package)?;
+    }
+    std::fs::create_dir_all(&package)?;
+    let sources = root.join("crates").join("sinew-py").join("python").join("sinew");
+    for entry in std::fs::read_dir(&sources)? {
+        let path = entry?.path();
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        // The package's own files; not a module a local `maturin develop` left there.
+        if path.is_file() && !name.ends_with(".so") && !name.ends_with(".pyd") {
+            std::fs::copy(&path, package.join(&name))?;
+        }
+    }
+    std::fs::copy(&built, package.join("_sinew.so"))?;
+    println!("== the package: {} (extension module from {})", package.display(), built.display());
+    Ok(out)
 }
 
 /// Run `command`; an error naming it unless it exits with 0 (pytest's 5, "no tests collected",
