@@ -223,10 +223,11 @@ impl Planner {
         } else {
             bundle::feasible_point(k, &linear)?.ok_or(PlanError::BudgetsInfeasible)?
         };
-        let total_of = |lambda: &[f64]| -> f64 {
-            let s = column_sums(&set);
-            set.particular().iter().sum::<f64>() + bundle::dot(&s, lambda)
-        };
+        // Σ f = Σ f_p + (Nᵀ 1)ᵀ λ: its constant and gradient, once per plan.
+        let sums = column_sums(&set);
+        let particular_total: f64 = set.particular().iter().sum();
+        let negated_sums: Vec<f64> = sums.iter().map(|s| -s).collect();
+        let total_of = |lambda: &[f64]| particular_total + bundle::dot(&sums, lambda);
         let scale = pencil_scale(&pencil);
         // Phase 1: a stable point (margin ≥ ε), by maximising the margin.
         let margin = requirements.margin;
@@ -337,9 +338,7 @@ impl Planner {
                     end.least_stiffness(&pencil, None).ok_or(PlanError::NoEndStiffness)?
                 }
                 Objective::Volume => end.log_volume(&pencil).ok_or(PlanError::NoEndStiffness)?,
-                Objective::LeastTension => {
-                    (-total_of(l), column_sums(&set).iter().map(|s| -s).collect())
-                }
+                Objective::LeastTension => (-total_of(l), negated_sums.clone()),
             };
             Ok(Evaluation {
                 objective: Some(Cut { at: l.to_vec(), value: value.0, gradient: value.1 }),
