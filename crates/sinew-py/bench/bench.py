@@ -34,6 +34,12 @@ def configurations(robot, rows=10_000):
     return out
 
 
+def loop(f, calls):
+    """`f()` `calls` times, each result dropped before the next call (as in a user's loop)."""
+    for _ in range(calls):
+        f()
+
+
 def best(f, repeat):
     times = []
     for _ in range(repeat):
@@ -49,8 +55,25 @@ levels = np.full(5, 0.5)
 calls = 20_000
 for _ in range(1000):
     arm.evaluate(E4_Q, E4_F0, levels=levels)
-per_call = best(lambda: [arm.evaluate(E4_Q, E4_F0, levels=levels) for _ in range(calls)], 5) / calls
+per_call = best(lambda: loop(lambda: arm.evaluate(E4_Q, E4_F0, levels=levels), calls), 5) / calls
 print(f"evaluate (cdhrm5, E4, levels): {per_call * 1e6:.2f} µs per call (best of 5 × {calls})")
+
+# The arrays are made when first read: the same call, then reading K_fd, then every attribute.
+def with_k_fd():
+    return arm.evaluate(E4_Q, E4_F0, levels=levels).k_fd
+
+
+ATTRIBUTES = [name for name in dir(sinew.ArmResult) if not name.startswith("_")]
+
+
+def with_everything():
+    r = arm.evaluate(E4_Q, E4_F0, levels=levels)
+    return [getattr(r, name) for name in ATTRIBUTES]
+
+
+for label, f in [("evaluate + .k_fd", with_k_fd), (f"evaluate + all {len(ATTRIBUTES)} attributes", with_everything)]:
+    t = best(lambda: loop(f, calls), 5) / calls
+    print(f"{label}: {t * 1e6:.2f} µs per call (best of 5 × {calls})")
 
 Q = configurations(robot)
 batch = best(lambda: arm.evaluate_many(Q, E4_F0, levels=levels), 10)

@@ -3,17 +3,19 @@
 
 use std::sync::{Mutex, OnceLock};
 
+use faer::MatRef;
 use nalgebra::{Matrix3, Vector3, Vector6};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use sinew::indicators::StiffnessEllipsoid;
 use sinew::planner::{Objective, PlanSettings, Planner, PlannerData, Requirements};
 use sinew::statics::{TensionChoice, TensionPolicy};
-use sinew::stiffness::{ArmStiffnessData, StiffnessError};
+use sinew::stiffness::{ArmStiffnessData, StiffnessError, stability_margin};
 
 use crate::batch::{BatchChoice, evaluate_many};
-use crate::convert::{faer2, finite, matrix, na2, reshape, vec1, vector};
+use crate::convert::{finite, matrix, na2, reshape, vec1, vector};
 use crate::errors::{exception, input, library};
+use crate::lazy::{LazyArray, optional};
 use crate::model::{Robot, Routing};
 
 /// The model of the pipeline `Q → K_x` for a robot and a routing (Pinocchio's model), with
@@ -26,67 +28,246 @@ pub struct ArmStiffness {
     planner: OnceLock<(Planner, Mutex<PlannerData>)>,
 }
 
-/// The result of `ArmStiffness.evaluate`: numpy arrays (SI units) and floats.
-#[pyclass(module = "sinew", frozen, get_all)]
+/// The result of `ArmStiffness.evaluate`: numpy arrays (SI units) and floats. The numbers are
+/// copied out of the workspace when `evaluate` returns; each array is made on its first read
+/// (then the same object), and `min_eigenvalue` and the ellipsoid are computed on their first
+/// read, so a call pays only for what is used.
+#[pyclass(module = "sinew", frozen)]
 #[derive(Debug)]
 pub struct ArmResult {
     /// The configuration, rad (dof,).
-    q: Py<PyArray1<f64>>,
+    q: LazyArray,
     /// The wrench the end exerts, base frame, force first (6,).
-    wrench: Py<PyArray1<f64>>,
+    wrench: LazyArray,
     /// `"levels"`, `"given"` or the policy's name.
+    #[pyo3(get)]
     policy: &'static str,
     /// The tension levels (joints,), or None.
-    levels: Option<Py<PyArray1<f64>>>,
+    levels: Option<LazyArray>,
     /// The policy's objective (Σ f, |f| or the least distance to a limit, N), or None.
+    #[pyo3(get)]
     policy_objective: Option<f64>,
     /// `T0 = T_g + J_xᵀ F0`, N m (dof,).
-    t0: Py<PyArray1<f64>>,
+    t0: LazyArray,
     /// Tensions, N, routing order (cables,).
-    tensions: Py<PyArray1<f64>>,
+    tensions: LazyArray,
     /// Per joint `[λ_min, λ_max]` of the closed form (joints, 2), or None.
-    lambda_intervals: Option<Py<PyArray2<f64>>>,
+    lambda_intervals: Option<LazyArray>,
     /// `Σ f_c H_c` (dof, dof).
-    k_controllable: Py<PyArray2<f64>>,
+    k_controllable: LazyArray,
     /// `J_cᵀ K_l J_c` (dof, dof).
-    k_inherent: Py<PyArray2<f64>>,
+    k_inherent: LazyArray,
     /// `K_q`, N m/rad (dof, dof).
-    k_q: Py<PyArray2<f64>>,
+    k_q: LazyArray,
     /// `K_W = ∂T0/∂Q`, N m/rad (dof, dof).
-    k_w: Py<PyArray2<f64>>,
+    k_w: LazyArray,
     /// `J_x`, linear rows first, base frame (6, dof).
-    j_x: Py<PyArray2<f64>>,
+    j_x: LazyArray,
     /// Whether `K_q + K_W` is positive definite.
+    #[pyo3(get)]
     stable: bool,
-    /// `λ_min` of the symmetric part of `K_q + K_W`, N m/rad.
-    min_eigenvalue: f64,
+    /// `λ_min` of the symmetric part of `K_q + K_W`, N m/rad (computed on first read).
+    min_eigenvalue: OnceLock<f64>,
     /// `C_x` (6, 6), or None when unstable.
-    c_x: Option<Py<PyArray2<f64>>>,
+    c_x: Option<LazyArray>,
     /// `K_x = C_x⁻¹` (6, 6), or None when unstable or `J_x` is rank-deficient.
-    k_x: Option<Py<PyArray2<f64>>>,
+    k_x: Option<LazyArray>,
     /// `K_fd = K_x[0:3, 0:3]`, N/m (3, 3), or None.
-    k_fd: Option<Py<PyArray2<f64>>>,
-    /// The ellipsoid's eigenvalues of `K_fd`, ascending, N/m (3,), or None.
-    eigenvalues: Option<Py<PyArray1<f64>>>,
-    /// `directions[k]`: the unit principal direction of `eigenvalues[k]` (3, 3), or None.
-    directions: Option<Py<PyArray2<f64>>>,
-    /// `1/λ_k`, m/N (3,), or None unless `K_fd` is positive definite.
-    semi_axes: Option<Py<PyArray1<f64>>>,
-    /// `λ_max / λ_min` of `K_fd`, or None.
-    condition_number: Option<f64>,
-    /// `4π/3 · Π 1/λ_k`, m³/N³, or None.
-    volume: Option<f64>,
-    /// Why some results are None.
+    k_fd: Option<(Matrix3<f64>, LazyArray)>,
+    /// The ellipsoid of `K_fd` (computed on first read; None without `K_fd`).
+    ellipsoid: OnceLock<Option<Ellipsoid>>,
+    /// Why some results are None (without the ellipsoid's note).
     notes: Vec<String>,
+}
+
+/// The stiffness ellipsoid's numbers as `ArmResult` gives them.
+#[derive(Debug)]
+struct Ellipsoid {
+    /// Eigenvalues of `K_fd`, ascending, N/m (3,).
+    eigenvalues: LazyArray,
+    /// Row k: the unit principal direction of `eigenvalues[k]` (3, 3).
+    directions: LazyArray,
+    /// `1/λ_k`, m/N (3,), None unless `K_fd` is positive definite.
+    semi_axes: Option<LazyArray>,
+    /// `λ_max / λ_min`.
+    condition_number: Option<f64>,
+    /// `4π/3 · Π 1/λ_k`, m³/N³.
+    volume: Option<f64>,
+}
+
+impl ArmResult {
+    fn ellipsoid(&self) -> PyResult<Option<&Ellipsoid>> {
+        if let Some(e) = self.ellipsoid.get() {
+            return Ok(e.as_ref());
+        }
+        let computed = match &self.k_fd {
+            None => None,
+            Some((k_fd, _)) => {
+                let e = StiffnessEllipsoid::new(k_fd).map_err(library)?;
+                Some(Ellipsoid {
+                    eigenvalues: LazyArray::vector(e.eigenvalues.as_slice()),
+                    directions: LazyArray::nalgebra(&e.directions.transpose()),
+                    semi_axes: e.semi_axes().map(|a| LazyArray::vector(a.as_slice())),
+                    condition_number: e.condition_number(),
+                    volume: e.volume(),
+                })
+            }
+        };
+        Ok(self.ellipsoid.get_or_init(|| computed).as_ref())
+    }
 }
 
 #[pymethods]
 impl ArmResult {
-    fn __repr__(&self) -> String {
-        format!(
+    /// The configuration, rad (dof,).
+    #[getter]
+    fn q(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.q.get(py)
+    }
+
+    /// The wrench the end exerts, base frame, force first (6,).
+    #[getter]
+    fn wrench(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.wrench.get(py)
+    }
+
+    /// The tension levels (joints,), or None.
+    #[getter]
+    fn levels(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.levels.as_ref())
+    }
+
+    /// `T0 = T_g + J_xᵀ F0`, N m (dof,).
+    #[getter]
+    fn t0(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.t0.get(py)
+    }
+
+    /// Tensions, N, routing order (cables,).
+    #[getter]
+    fn tensions(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.tensions.get(py)
+    }
+
+    /// Per joint `[λ_min, λ_max]` of the closed form (joints, 2), or None.
+    #[getter]
+    fn lambda_intervals(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.lambda_intervals.as_ref())
+    }
+
+    /// `Σ f_c H_c` (dof, dof).
+    #[getter]
+    fn k_controllable(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.k_controllable.get(py)
+    }
+
+    /// `J_cᵀ K_l J_c` (dof, dof).
+    #[getter]
+    fn k_inherent(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.k_inherent.get(py)
+    }
+
+    /// `K_q`, N m/rad (dof, dof).
+    #[getter]
+    fn k_q(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.k_q.get(py)
+    }
+
+    /// `K_W = ∂T0/∂Q`, N m/rad (dof, dof).
+    #[getter]
+    fn k_w(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.k_w.get(py)
+    }
+
+    /// `J_x`, linear rows first, base frame (6, dof).
+    #[getter]
+    fn j_x(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.j_x.get(py)
+    }
+
+    /// `λ_min` of the symmetric part of `K_q + K_W`, N m/rad.
+    #[getter]
+    fn min_eigenvalue(&self) -> PyResult<f64> {
+        if let Some(&m) = self.min_eigenvalue.get() {
+            return Ok(m);
+        }
+        let n = self.k_q.values().len().isqrt();
+        let k_q = MatRef::from_row_major_slice(self.k_q.values(), n, n);
+        let k_w = MatRef::from_row_major_slice(self.k_w.values(), n, n);
+        let m = stability_margin(k_q, k_w).map_err(library)?;
+        Ok(*self.min_eigenvalue.get_or_init(|| m))
+    }
+
+    /// `C_x` (6, 6), or None when unstable.
+    #[getter]
+    fn c_x(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.c_x.as_ref())
+    }
+
+    /// `K_x = C_x⁻¹` (6, 6), or None when unstable or `J_x` is rank-deficient.
+    #[getter]
+    fn k_x(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.k_x.as_ref())
+    }
+
+    /// `K_fd = K_x[0:3, 0:3]`, N/m (3, 3), or None.
+    #[getter]
+    fn k_fd(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.k_fd.as_ref().map(|(_, a)| a))
+    }
+
+    /// The ellipsoid's eigenvalues of `K_fd`, ascending, N/m (3,), or None.
+    #[getter]
+    fn eigenvalues(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.ellipsoid()?.map(|e| &e.eigenvalues))
+    }
+
+    /// `directions[k]`: the unit principal direction of `eigenvalues[k]` (3, 3), or None.
+    #[getter]
+    fn directions(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.ellipsoid()?.map(|e| &e.directions))
+    }
+
+    /// `1/λ_k`, m/N (3,), or None unless `K_fd` is positive definite.
+    #[getter]
+    fn semi_axes(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        optional(py, self.ellipsoid()?.and_then(|e| e.semi_axes.as_ref()))
+    }
+
+    /// `λ_max / λ_min` of `K_fd`, or None.
+    #[getter]
+    fn condition_number(&self) -> PyResult<Option<f64>> {
+        Ok(self.ellipsoid()?.and_then(|e| e.condition_number))
+    }
+
+    /// `4π/3 · Π 1/λ_k`, m³/N³, or None.
+    #[getter]
+    fn volume(&self) -> PyResult<Option<f64>> {
+        Ok(self.ellipsoid()?.and_then(|e| e.volume))
+    }
+
+    /// Why some results are None.
+    #[getter]
+    fn notes(&self) -> PyResult<Vec<String>> {
+        let mut notes = self.notes.clone();
+        if let Some(e) = self.ellipsoid()?
+            && e.semi_axes.is_none()
+        {
+            notes.push(
+                "K_fd is not positive definite: the ellipsoid's semi-axes, condition number and volume are None"
+                    .to_owned(),
+            );
+        }
+        Ok(notes)
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        Ok(format!(
             "sinew.ArmResult(stable={}, min_eigenvalue={:e}, policy={:?})",
-            self.stable, self.min_eigenvalue, self.policy
-        )
+            self.stable,
+            self.min_eigenvalue()?,
+            self.policy
+        ))
     }
 }
 
@@ -226,7 +407,6 @@ impl ArmStiffness {
     #[pyo3(signature = (q, wrench = None, levels = None, policy = None, tensions = None))]
     fn evaluate<'py>(
         &self,
-        py: Python<'py>,
         q: &Bound<'py, PyAny>,
         wrench: Option<&Bound<'py, PyAny>>,
         levels: Option<&Bound<'py, PyAny>>,
@@ -288,57 +468,33 @@ impl ArmStiffness {
             }
             Err(e) => return Err(library(e)),
         };
-        let min_eigenvalue = data.stability_margin().map_err(library)?;
-        let unbind = |a: Bound<'py, PyArray2<f64>>| a.unbind();
-        let c_x = stable.then(|| unbind(faer2(py, data.compliance())));
-        let mut result = ArmResult {
-            q: vec1(py, &q).unbind(),
-            wrench: vec1(py, f0.as_slice()).unbind(),
+        let k_fd = full_rank.then(|| data.k_fd());
+        let result = ArmResult {
+            q: LazyArray::vector(&q),
+            wrench: LazyArray::vector(f0.as_slice()),
             policy: policy_name,
-            levels: levels.as_ref().map(|l| vec1(py, l).unbind()),
+            levels: levels.as_deref().map(LazyArray::vector),
             policy_objective: data.statics.distribution.as_ref().map(|d| d.objective),
-            t0: vec1(py, &data.statics.t0).unbind(),
-            tensions: vec1(py, data.tensions()).unbind(),
-            lambda_intervals: None,
-            k_controllable: unbind(faer2(py, data.k_controllable())),
-            k_inherent: unbind(faer2(py, data.k_inherent())),
-            k_q: unbind(faer2(py, data.k_q())),
-            k_w: unbind(faer2(py, data.k_w())),
-            j_x: unbind(faer2(py, data.j_x())),
+            t0: LazyArray::vector(&data.statics.t0),
+            tensions: LazyArray::vector(data.tensions()),
+            lambda_intervals: levels.is_some().then(|| {
+                let iv = data.intervals();
+                let flat = iv.iter().flat_map(|i| [i.lambda_min, i.lambda_max]).collect();
+                LazyArray::new(vec![iv.len(), 2], flat)
+            }),
+            k_controllable: LazyArray::faer(data.k_controllable()),
+            k_inherent: LazyArray::faer(data.k_inherent()),
+            k_q: LazyArray::faer(data.k_q()),
+            k_w: LazyArray::faer(data.k_w()),
+            j_x: LazyArray::faer(data.j_x()),
             stable,
-            min_eigenvalue,
-            c_x,
-            k_x: None,
-            k_fd: None,
-            eigenvalues: None,
-            directions: None,
-            semi_axes: None,
-            condition_number: None,
-            volume: None,
+            min_eigenvalue: OnceLock::new(),
+            c_x: stable.then(|| LazyArray::faer(data.compliance())),
+            k_x: full_rank.then(|| LazyArray::faer(data.stiffness())),
+            k_fd: k_fd.map(|k| (k, LazyArray::nalgebra(&k))),
+            ellipsoid: OnceLock::new(),
             notes,
         };
-        if levels.is_some() {
-            let iv = data.intervals();
-            let flat = iv.iter().flat_map(|i| [i.lambda_min, i.lambda_max]).collect();
-            result.lambda_intervals = Some(crate::convert::vec2(py, iv.len(), 2, flat)?.unbind());
-        }
-        if full_rank {
-            let k_fd = data.k_fd();
-            let ellipsoid = StiffnessEllipsoid::new(&k_fd).map_err(library)?;
-            result.k_x = Some(unbind(faer2(py, data.stiffness())));
-            result.k_fd = Some(unbind(na2(py, &k_fd)));
-            result.eigenvalues = Some(vec1(py, ellipsoid.eigenvalues.as_slice()).unbind());
-            result.directions = Some(unbind(na2(py, &ellipsoid.directions.transpose())));
-            result.semi_axes = ellipsoid.semi_axes().map(|a| vec1(py, a.as_slice()).unbind());
-            result.condition_number = ellipsoid.condition_number();
-            result.volume = ellipsoid.volume();
-            if !ellipsoid.is_positive_definite() {
-                result.notes.push(
-                    "K_fd is not positive definite: the ellipsoid's semi-axes, condition number and volume are None"
-                        .to_owned(),
-                );
-            }
-        }
         Ok(result)
     }
 

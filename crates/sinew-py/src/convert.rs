@@ -1,7 +1,6 @@
 //! numpy in and out: checked inputs (shape, finiteness) and row-major arrays from the
 //! library's matrices.
 
-use faer::MatRef;
 use nalgebra::{Dim, Matrix, RawStorage};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
@@ -90,11 +89,6 @@ pub fn vec2<'py>(
     let a = Array2::from_shape_vec((rows, cols), data)
         .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py))
-}
-
-/// A faer matrix as a 2-D array.
-pub fn faer2<'py>(py: Python<'py>, m: MatRef<'_, f64>) -> Bound<'py, PyArray2<f64>> {
-    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
 /// A nalgebra matrix as a 2-D array.

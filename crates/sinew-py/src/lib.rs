@@ -13,6 +13,7 @@ pub mod batch;
 mod convert;
 mod errors;
 mod indicators;
+mod lazy;
 mod model;
 
 /// The extension module `sinew._sinew`, re-exported by the `sinew` package.

@@ -94,6 +94,23 @@ def test_shapes_and_dtypes(arm):
     assert s.stable and s.c_x.shape == (6, 6) and s.k_x is None and s.notes
 
 
+def test_results_are_snapshots(arm):
+    # Arrays are made on first read, from numbers copied when evaluate returned: a later call
+    # (which reuses the model's workspace) changes nothing in an earlier result, and a second
+    # read gives the same array object.
+    first = arm.evaluate(E4_Q, E4_F0, levels=[0.5] * 5)
+    expected = {name: np.array(getattr(arm.evaluate(E4_Q, E4_F0, levels=[0.5] * 5), name))
+                for name in ["k_q", "k_w", "c_x", "k_fd", "eigenvalues", "t0"]}
+    other = arm.evaluate(0.5 * E4_Q, E4_F0, levels=[1.0] * 5)
+    assert not np.allclose(other.k_q, expected["k_q"])
+    for name, value in expected.items():
+        a = getattr(first, name)
+        assert np.array_equal(a, value), name
+        assert getattr(first, name) is a, name
+    assert first.min_eigenvalue == arm.evaluate(E4_Q, E4_F0, levels=[0.5] * 5).min_eigenvalue
+    assert first.min_eigenvalue != other.min_eigenvalue
+
+
 def test_bad_input_raises(arm):
     with pytest.raises(sinew.InputError, match="q: expected 10 values, got 3"):
         arm.evaluate([0, 0, 0])

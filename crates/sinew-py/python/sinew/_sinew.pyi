@@ -91,7 +91,8 @@ def load_routing(robot: Robot, path_or_model: str = "decoupled") -> Routing:
     """A routing file's path, or ``"decoupled"``/``"routed"`` (``cables.toml``/``cables-routed.toml``)."""
 
 class ArmResult:
-    """One evaluation of the arm (``sinew arm --json``'s numbers)."""
+    """One evaluation of the arm (``sinew arm --json``'s numbers). Its numbers are copied when
+    ``evaluate`` returns; each array is made on its first read (then the same object)."""
 
     q: F64
     wrench: F64
