@@ -50,7 +50,7 @@ pub mod spec;
 
 pub use error::{JointProblem, Result, RoutingError};
 pub use geometry::{
-    Order, RoutingData, SegmentHessians, compute_cable_geometry,
+    HessianBatch, Order, RoutingData, SegmentHessians, compute_cable_geometry,
     compute_cable_geometry_from_kinematics,
 };
 pub use routing::{

@@ -21,7 +21,7 @@ use std::ops::Range;
 
 use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
-use sinew_routing::{Routing, RoutingData, SegmentHessians};
+use sinew_routing::{HessianBatch, Routing, RoutingData, SegmentHessians};
 
 use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
@@ -247,6 +247,9 @@ fn add_weighted_hessians(
     tensions: &[f64],
     out: &mut ColMajor,
 ) -> Result<(), StiffnessError> {
+    if let Some(batches) = hessians.batches() {
+        return add_weighted_hessians_batched(routing, batches, tensions, out);
+    }
     for (s, (seg, h)) in hessians.iter().enumerate() {
         let (lo, n) = (seg.dofs.start, seg.dofs.len());
         if n == 0 {
@@ -286,9 +289,69 @@ fn add_weighted_hessians(
     Ok(())
 }
 
-/// Width of the row blocks of [`InherentPlan::add_upper`]: eight `f64` accumulators, two AVX
-/// registers.
+/// [`add_weighted_hessians`] batch by batch (routed models): a batch's segments cross the same
+/// DOFs, so each entry of its block is one running sum over the batch's segments, kept in a
+/// register, in routing order (the same sums in the same order), reading the blocks and the
+/// cables in storage order.
+fn add_weighted_hessians_batched<'a>(
+    routing: &Routing,
+    batches: impl Iterator<Item = HessianBatch<'a>>,
+    tensions: &[f64],
+    out: &mut ColMajor,
+) -> Result<(), StiffnessError> {
+    let tension_mismatch = || StiffnessError::DimensionMismatch {
+        what: "tensions",
+        expected: routing.cable_count(),
+        got: tensions.len(),
+    };
+    for batch in batches {
+        let (lo, n) = (batch.dofs.start, batch.dofs.len());
+        if batch.blocks.len() != batch.cables.len() * n * n
+            || lo + n > out.rows()
+            || lo + n > out.cols()
+        {
+            return Err(StiffnessError::DimensionMismatch {
+                what: "segment Hessian batch",
+                expected: batch.cables.len() * n * n,
+                got: batch.blocks.len(),
+            });
+        }
+        if n == 2 {
+            let mut acc = [
+                out.col(lo)[lo],
+                out.col(lo)[lo + 1],
+                out.col(lo + 1)[lo],
+                out.col(lo + 1)[lo + 1],
+            ];
+            for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(4)) {
+                let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
+                for t in 0..4 {
+                    acc[t] += w * h[t];
+                }
+            }
+            out.col_mut(lo)[lo..lo + 2].copy_from_slice(&acc[..2]);
+            out.col_mut(lo + 1)[lo..lo + 2].copy_from_slice(&acc[2..]);
+            continue;
+        }
+        for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(n * n)) {
+            let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
+            for (k, h) in h.chunks_exact(n).enumerate() {
+                let col = &mut out.col_mut(lo + k)[lo..lo + n];
+                for (v, h) in col.iter_mut().zip(h) {
+                    *v += w * h;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Height of the tiles of [`InherentPlan::add_upper`]: eight rows, two AVX registers.
 const LANES: usize = 8;
+
+/// Width of the tiles of [`InherentPlan::add_upper`]: four columns, so a tile's 32
+/// accumulators fill eight AVX registers and each row of `J_c` loaded serves four columns.
+const COLUMNS: usize = 4;
 
 /// What [`InherentPlan::add_upper`] needs of the routing, computed once per model: for each
 /// column `j` of `J_cᵀ K_l J_c`, the cables whose rows of `J_c` can be non-zero there and the
@@ -342,15 +405,18 @@ impl InherentPlan {
     pub(crate) fn scratch(&self) -> InherentScratch {
         InherentScratch {
             rows: vec![0.0; self.stiffness.len() * self.stride],
-            weights: vec![0.0; self.stiffness.len()],
+            weights: vec![0.0; self.stiffness.len() * COLUMNS],
         }
     }
 
-    /// `out += J_cᵀ K_l J_c` on and above the diagonal (the caller mirrors it), column `j` over
-    /// the cables crossing DOF `j` only, rows in blocks of [`LANES`] accumulated in registers
-    /// over the cables: entry `(i, j)` is `Σ_c (k_c J_c[c, j]) · J_c[c, i]` summed in routing
-    /// order from zero, the same sum as [`add_inherent_upper`] (the extra terms are exact
-    /// zeros). `O(Σ_j |cables crossing j| · j)`, no allocation.
+    /// `out += J_cᵀ K_l J_c` on and above the diagonal (the caller mirrors it), in tiles of
+    /// [`LANES`] rows × [`COLUMNS`] columns accumulated in registers over the cables crossing
+    /// any of the tile's columns (each row of `J_c` loaded once per tile serves four columns;
+    /// compiled for AVX2 where present, through pulp's dispatch): entry `(i, j)` is
+    /// `Σ_c (k_c J_c[c, j]) · J_c[c, i]` summed in routing order from zero, the same sum as
+    /// [`add_inherent_upper`] (the extra terms, cables that do not cross `j` or `i`, are exact
+    /// zeros; Rust does not fuse the multiply and the add, so AVX2 changes no rounding).
+    /// `O(Σ_j |cables crossing j| · j)`, no allocation.
     fn add_upper(
         &self,
         j_c: MatRef<'_, f64>,
@@ -363,7 +429,7 @@ impl InherentPlan {
             ("cable Jacobian", m, j_c.nrows()),
             ("cable Jacobian", n, j_c.ncols()),
             ("inherent scratch", m * stride, scratch.rows.len()),
-            ("inherent scratch", m, scratch.weights.len()),
+            ("inherent scratch", m * COLUMNS, scratch.weights.len()),
         ];
         for (what, expected, got) in sizes {
             if expected != got {
@@ -371,38 +437,99 @@ impl InherentPlan {
             }
         }
         let InherentScratch { rows, weights } = scratch;
-        for (c, row) in rows.chunks_exact_mut(stride).enumerate() {
-            for (i, v) in row[..n].iter_mut().enumerate() {
-                *v = j_c[(c, i)];
+        // J_c row by row, only where a cable can be non-zero (the rest stays zero from
+        // construction: J_c is exactly zero there at every configuration).
+        for (i, (_, cables)) in self.columns.iter().enumerate() {
+            let col = j_c.col(i);
+            for c in cables.clone() {
+                rows[c * stride + i] = col[c];
             }
         }
-        for (j, (first_row, cables)) in self.columns.iter().enumerate() {
-            let rows = &rows[cables.start * stride..cables.end * stride];
-            let (weights, stiffness) =
-                (&mut weights[cables.clone()], &self.stiffness[cables.clone()]);
-            for ((w, k), row) in weights.iter_mut().zip(stiffness).zip(rows.chunks_exact(stride)) {
-                *w = k * row[j];
+        let (rows, columns, stiffness) = (&*rows, &self.columns[..], &self.stiffness[..]);
+        pulp::Arch::new().dispatch(Tiles { n, stride, rows, columns, stiffness, weights, out });
+        Ok(())
+    }
+}
+
+/// The loop of [`InherentPlan::add_upper`] over tiles of [`LANES`] rows × [`COLUMNS`]
+/// columns, as a pulp operation: `with_simd` is inlined into pulp's dispatch, so the loop is
+/// compiled for AVX2 where the processor has it. `J_c` row by row (`stride` apart), the plan's
+/// columns, the cables' stiffness, the weights' scratch and the output.
+struct Tiles<'a> {
+    n: usize,
+    stride: usize,
+    rows: &'a [f64],
+    columns: &'a [(usize, Range<usize>)],
+    stiffness: &'a [f64],
+    weights: &'a mut [f64],
+    out: &'a mut ColMajor,
+}
+
+impl pulp::WithSimd for Tiles<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        let Tiles { n, stride, rows, columns, stiffness, weights, out } = self;
+        let mut j0 = 0;
+        while j0 < n {
+            let tile = COLUMNS.min(n - j0);
+            // The union of the tile's cable ranges (nested or not: cables outside a
+            // column's range have an exact zero there, so their weight is zero).
+            let (mut lo, mut hi) = (usize::MAX, 0);
+            let mut first = usize::MAX;
+            for (f, cables) in &columns[j0..j0 + tile] {
+                if !cables.is_empty() {
+                    lo = lo.min(cables.start);
+                    hi = hi.max(cables.end);
+                    first = first.min(*f);
+                }
             }
-            let col = &mut out.col_mut(j)[..=j];
-            let mut block = first_row - first_row % LANES;
-            while block <= j {
-                let mut acc = [0.0; LANES];
-                for (&w, row) in weights.iter().zip(rows.chunks_exact(stride)) {
+            if lo >= hi {
+                j0 += tile;
+                continue;
+            }
+            let rows = &rows[lo * stride..hi * stride];
+            let weights = &mut weights[..(hi - lo) * COLUMNS];
+            for ((w, k), row) in weights
+                .chunks_exact_mut(COLUMNS)
+                .zip(&stiffness[lo..hi])
+                .zip(rows.chunks_exact(stride))
+            {
+                for t in 0..COLUMNS {
+                    w[t] = if t < tile { k * row[j0 + t] } else { 0.0 };
+                }
+            }
+            let last = j0 + tile - 1;
+            let mut block = first - first % LANES;
+            while block <= last {
+                let mut acc = [[0.0; LANES]; COLUMNS];
+                for (w, row) in weights.chunks_exact(COLUMNS).zip(rows.chunks_exact(stride)) {
                     let r = &row[block..block + LANES];
-                    for t in 0..LANES {
-                        acc[t] += w * r[t];
+                    for t in 0..COLUMNS {
+                        for l in 0..LANES {
+                            acc[t][l] += w[t] * r[l];
+                        }
                     }
                 }
-                for t in 0..LANES {
-                    let i = block + t;
-                    if i >= *first_row && i <= j {
-                        col[i] += acc[t];
+                for t in 0..tile {
+                    let j = j0 + t;
+                    let first_row = columns[j].0;
+                    if columns[j].1.is_empty() {
+                        continue;
+                    }
+                    let col = out.col_mut(j);
+                    for l in 0..LANES {
+                        let i = block + l;
+                        if i >= first_row && i <= j {
+                            col[i] += acc[t][l];
+                        }
                     }
                 }
                 block += LANES;
             }
+            j0 += tile;
         }
-        Ok(())
     }
 }
 

@@ -96,7 +96,13 @@ fn the_routed_pipeline_matches_the_reference_at_10_50_and_200_dof() {
                 assert_eq!(data.end_solver(), EndSolver::Dense, "{name}");
                 let r = reference(&robot, &routing, &q, f0, &data);
                 let label = format!("{name} #{k} F0 = {:?}", f0.as_slice());
-                // The same sums in the same order: equal, not only close.
+                // The same sums in the same order (the tiles' extra terms are exact zeros, the
+                // batched segment Hessians summed in routing order): equal, not only close.
+                assert!(
+                    data.k_inherent() == r.k_inherent.as_ref(),
+                    "{label}: J_cᵀ K_l J_c differs"
+                );
+                assert!(data.k_q() == r.k_q.as_ref(), "{label}: K_q differs");
                 let err = rel_diff(data.k_inherent(), r.k_inherent.as_ref());
                 assert!(err <= RTOL, "{label}: J_cᵀ K_l J_c off by {err:e}");
                 let err = rel_diff(data.k_q(), r.k_q.as_ref());
@@ -119,6 +125,36 @@ fn the_routed_pipeline_matches_the_reference_at_10_50_and_200_dof() {
             }
         }
         assert!(checked >= 6, "{name}: only {checked} stable configurations compared");
+    }
+}
+
+#[test]
+fn batched_and_segment_by_segment_geometry_give_the_same_arm_bit_for_bit() {
+    for (name, robot, routing, centre) in arms() {
+        assert!(routing.is_batched(), "{name}");
+        let reference = routing.unbatched();
+        let (batched, plain) = (
+            ArmStiffness::new(&robot, &routing).unwrap(),
+            ArmStiffness::new(&robot, &reference).unwrap(),
+        );
+        let (mut a, mut b) = (ArmStiffnessData::new(&batched), ArmStiffnessData::new(&plain));
+        let mut rng = config::rng(5);
+        let f0 = Vector6::new(0.0, 1e-3, 0.0, 0.0, 0.0, 0.0);
+        for k in 0..4 {
+            let q = if k == 0 { centre.clone() } else { config::near(&centre, 0.02, &mut rng) };
+            let levels = vec![0.3; robot.dof() / 2];
+            let (ra, rb) = (
+                batched.evaluate(&mut a, &q, &f0, &levels),
+                plain.evaluate(&mut b, &q, &f0, &levels),
+            );
+            assert_eq!(format!("{ra:?}"), format!("{rb:?}"), "{name} #{k}");
+            assert!(a.k_controllable() == b.k_controllable(), "{name} #{k}: K_c");
+            assert!(a.k_inherent() == b.k_inherent(), "{name} #{k}: K_i");
+            if ra.is_ok() {
+                assert!(a.compliance() == b.compliance(), "{name} #{k}: C_x");
+                assert!(a.stiffness() == b.stiffness(), "{name} #{k}: K_x");
+            }
+        }
     }
 }
 

@@ -1,9 +1,10 @@
 //! The per-configuration computation: lengths, `J_c` and the segment Hessians (module docs
 //! of [`super`]).
 
+use super::batch::{BatchFrames, BatchOut, SegmentPlan, run_batch};
 use super::{Order, RoutingData};
 use crate::error::{Result, RoutingError};
-use crate::routing::{MIN_SEGMENT_LENGTH, Routing};
+use crate::routing::{MIN_SEGMENT_LENGTH, Routing, Segment};
 use sinew_robot::{Robot, RobotData};
 
 /// Forward kinematics at `q`, then [`compute_cable_geometry_from_kinematics`]: the cable
@@ -110,50 +111,221 @@ pub fn compute_cable_geometry_from_kinematics(
         hessians,
         v,
         g,
+        batch,
         ..
     } = data;
-    for (s, seg) in routing.segments.iter().enumerate() {
-        let o_p_a = transform(&frames[seg.proximal.body], &seg.proximal_point);
-        let o_p_b = transform(&frames[seg.distal.body], &seg.distal_point);
-        let d = sub(&o_p_b, &o_p_a);
-        let length = dot(&d, &d).sqrt();
-        if length.is_nan() || length < MIN_SEGMENT_LENGTH {
-            let cable = routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default();
-            return Err(RoutingError::DegenerateSegment {
-                cable,
-                segment: seg.index,
-                length,
-                min: MIN_SEGMENT_LENGTH,
-            });
-        }
-        segment_lengths[s] = length;
-        lengths[seg.cable] += length;
-        if order == Order::Lengths || seg.dofs.is_empty() {
-            continue;
-        }
-        let inv_length = 1.0 / length;
-        let u = scale(&d, inv_length);
-        let (lo, n) = (seg.dofs.start, seg.dofs.len());
-        let (Some(a), Some(p)) = (axes.get(lo..lo + n), origins.get(lo..lo + n)) else {
-            return Err(mismatch(dof));
-        };
-        let Some(column) = jacobian.get_mut(seg.cable + lo * m..) else {
-            return Err(mismatch(dof));
-        };
-        let hessian = if order < Order::Hessians {
-            None
-        } else {
-            hessians.get_mut(seg.hessian_offset..seg.hessian_offset + n * n)
-        };
-        let parts = (&o_p_b, &d, &u, inv_length, a, p, m);
-        // A segment across one universal joint (the common case) with fixed sizes.
-        match n {
-            1 => segment_derivatives::<1>(parts, column, hessian),
-            2 => segment_derivatives::<2>(parts, column, hessian),
-            _ => segment_derivatives_any(parts, (&mut v[..], &mut g[..]), column, hessian),
+    let mut out = Outputs { lengths, segment_lengths, jacobian, hessians, m, order };
+    match &routing.plan {
+        Some(plan) => batched(routing, plan, (frames, axes, origins), (v, g), batch, &mut out)?,
+        None => {
+            for (s, seg) in routing.segments.iter().enumerate() {
+                one_segment(routing, s, seg, (frames, axes, origins), (v, g), &mut out)?;
+            }
         }
     }
     data.computed = Some(order);
+    Ok(())
+}
+
+/// Where the segment loop writes: the workspace's results, the number of cables (the column
+/// stride of `J_c`) and the order asked for.
+struct Outputs<'a> {
+    lengths: &'a mut [f64],
+    segment_lengths: &'a mut [f64],
+    jacobian: &'a mut [f64],
+    hessians: &'a mut [f64],
+    m: usize,
+    order: Order,
+}
+
+/// The kinematics as plain arrays: body frames, joint axes, joint origins (base frame).
+type Kinematics<'a> = (&'a [[f64; 12]], &'a [[f64; 3]], &'a [[f64; 3]]);
+
+fn degenerate(routing: &Routing, seg: &Segment, length: f64) -> RoutingError {
+    let cable = routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default();
+    RoutingError::DegenerateSegment { cable, segment: seg.index, length, min: MIN_SEGMENT_LENGTH }
+}
+
+/// Segment `s`: its length, and its row of `J_c` and Hessian block as `out.order` asks.
+fn one_segment(
+    routing: &Routing,
+    s: usize,
+    seg: &Segment,
+    (frames, axes, origins): Kinematics<'_>,
+    (v, g): (&mut [[f64; 3]], &mut [f64]),
+    out: &mut Outputs<'_>,
+) -> Result<()> {
+    let dof = routing.dof;
+    let (Some(frame_a), Some(frame_b)) =
+        (frames.get(seg.proximal.body), frames.get(seg.distal.body))
+    else {
+        return Err(mismatch(dof));
+    };
+    let o_p_a = transform(frame_a, &seg.proximal_point);
+    let o_p_b = transform(frame_b, &seg.distal_point);
+    let d = sub(&o_p_b, &o_p_a);
+    let length = dot(&d, &d).sqrt();
+    if length.is_nan() || length < MIN_SEGMENT_LENGTH {
+        return Err(degenerate(routing, seg, length));
+    }
+    out.segment_lengths[s] = length;
+    out.lengths[seg.cable] += length;
+    if out.order == Order::Lengths || seg.dofs.is_empty() {
+        return Ok(());
+    }
+    let inv_length = 1.0 / length;
+    let u = scale(&d, inv_length);
+    let (lo, n, m) = (seg.dofs.start, seg.dofs.len(), out.m);
+    let (Some(a), Some(p)) = (axes.get(lo..lo + n), origins.get(lo..lo + n)) else {
+        return Err(mismatch(dof));
+    };
+    let Some(column) = out.jacobian.get_mut(seg.cable + lo * m..) else {
+        return Err(mismatch(dof));
+    };
+    let hessian = if out.order < Order::Hessians {
+        None
+    } else {
+        out.hessians.get_mut(seg.hessian_offset..seg.hessian_offset + n * n)
+    };
+    let parts = (&o_p_b, &d, &u, inv_length, a, p, m);
+    // A segment across one universal joint (the common case) with fixed sizes.
+    match n {
+        1 => segment_derivatives::<1>(parts, column, hessian),
+        2 => segment_derivatives::<2>(parts, column, hessian),
+        _ => segment_derivatives_any(parts, (v, g), column, hessian),
+    }
+    Ok(())
+}
+
+/// The segment loop by batches ([`SegmentPlan`]): each batch of one or two joints computed
+/// by [`run_batch`] into `scratch`, then written to the workspace's results entry by entry in
+/// the plan's order (every cable's segments in routing order, as [`one_segment`] would add
+/// them); batches across more joints segment by segment. The whole loop runs inside pulp's
+/// dispatch (one detection per evaluation), compiled for AVX2 where the processor has it.
+fn batched(
+    routing: &Routing,
+    plan: &SegmentPlan,
+    kinematics: Kinematics<'_>,
+    scratch_per_segment: (&mut [[f64; 3]], &mut [f64]),
+    scratch: &mut [Vec<f64>; 6],
+    out: &mut Outputs<'_>,
+) -> Result<()> {
+    pulp::Arch::new().dispatch(Batched {
+        routing,
+        plan,
+        kinematics,
+        scratch_per_segment,
+        scratch,
+        out,
+    })
+}
+
+/// The arguments of [`batched`] as a pulp operation.
+struct Batched<'a, 'b> {
+    routing: &'a Routing,
+    plan: &'a SegmentPlan,
+    kinematics: Kinematics<'a>,
+    scratch_per_segment: (&'a mut [[f64; 3]], &'a mut [f64]),
+    scratch: &'a mut [Vec<f64>; 6],
+    out: &'a mut Outputs<'b>,
+}
+
+impl pulp::WithSimd for Batched<'_, '_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Result<()> {
+        let Batched { routing, plan, kinematics, scratch_per_segment, scratch, out } = self;
+        batched_loop(routing, plan, kinematics, scratch_per_segment, scratch, out)
+    }
+}
+
+#[inline(always)]
+fn batched_loop(
+    routing: &Routing,
+    plan: &SegmentPlan,
+    (frames, axes, origins): Kinematics<'_>,
+    (v, g): (&mut [[f64; 3]], &mut [f64]),
+    scratch: &mut [Vec<f64>; 6],
+    out: &mut Outputs<'_>,
+) -> Result<()> {
+    let dof = routing.dof;
+    let m = out.m;
+    let hessians = out.order >= Order::Hessians;
+    for batch in &plan.batches {
+        let joints = batch.distal - batch.proximal;
+        let entries = batch.entries.clone();
+        let lo = batch.proximal;
+        let (Some(proximal), Some(distal), Some(a), Some(p)) = (
+            frames.get(batch.proximal),
+            frames.get(batch.distal),
+            axes.get(lo..lo + joints),
+            origins.get(lo..lo + joints),
+        ) else {
+            return Err(mismatch(dof));
+        };
+        if joints > 2 {
+            for &s in &plan.segment[entries] {
+                let seg = &routing.segments[s];
+                one_segment(routing, s, seg, (frames, axes, origins), (&mut *v, &mut *g), out)?;
+            }
+            continue;
+        }
+        let n = entries.len();
+        let [l, g0, g1, h00, h01, h11] = scratch.each_mut().map(|v| &mut v[..n]);
+        run_batch(
+            &BatchFrames { proximal, distal, axes: a, origins: p },
+            plan.proximal.each_ref().map(|c| &c[entries.clone()]),
+            plan.distal.each_ref().map(|c| &c[entries.clone()]),
+            BatchOut { length: l, g: [g0, g1], h: [h00, h01, h11] },
+            joints,
+            hessians,
+        );
+        let (segments, cables) = (&plan.segment[entries.clone()], &plan.cable[entries.clone()]);
+        if let Some(i) = l.iter().position(|&x| x.is_nan() || x < MIN_SEGMENT_LENGTH) {
+            return Err(degenerate(routing, &routing.segments[segments[i]], l[i]));
+        }
+        for (&s, &length) in segments.iter().zip(l.iter()) {
+            out.segment_lengths[s] = length;
+        }
+        let derivatives = out.order >= Order::Jacobian && joints > 0;
+        match &batch.cables {
+            // Consecutive cables: whole slices of the lengths and of J_c's columns.
+            Some(range) => {
+                add(&mut out.lengths[range.clone()], l);
+                if derivatives {
+                    add(&mut out.jacobian[lo * m..][range.clone()], g0);
+                    if joints == 2 {
+                        add(&mut out.jacobian[(lo + 1) * m..][range.clone()], g1);
+                    }
+                }
+            }
+            None => {
+                for i in 0..n {
+                    let c = cables[i];
+                    out.lengths[c] += l[i];
+                    if derivatives {
+                        out.jacobian[c + lo * m] += g0[i];
+                        if joints == 2 {
+                            out.jacobian[c + (lo + 1) * m] += g1[i];
+                        }
+                    }
+                }
+            }
+        }
+        if hessians && joints > 0 {
+            // The batch's blocks are consecutive (the plan lays them out in its order).
+            let o = plan.hessian[entries.start];
+            let blocks = &mut out.hessians[o..o + n * joints * joints];
+            if joints == 1 {
+                blocks.copy_from_slice(h00);
+            } else {
+                for (i, block) in blocks.chunks_exact_mut(4).enumerate() {
+                    block.copy_from_slice(&[h00[i], h01[i], h01[i], h11[i]]);
+                }
+            }
+        }
+    }
     Ok(())
 }
 
@@ -222,6 +394,14 @@ fn segment_derivatives_any(
     }
 }
 
+/// `target[i] += values[i]`.
+#[inline(always)]
+fn add(target: &mut [f64], values: &[f64]) {
+    for (t, v) in target.iter_mut().zip(values) {
+        *t += v;
+    }
+}
+
 fn mismatch(dof: usize) -> RoutingError {
     RoutingError::WorkspaceMismatch { what: "robot workspace (joints)", expected: dof, got: 0 }
 }
@@ -230,7 +410,7 @@ fn mismatch(dof: usize) -> RoutingError {
 // code (the test profile is opt-level 1).
 
 #[inline(always)]
-fn transform(frame: &[f64; 12], p: &[f64; 3]) -> [f64; 3] {
+pub(super) fn transform(frame: &[f64; 12], p: &[f64; 3]) -> [f64; 3] {
     [
         frame[0] * p[0] + frame[3] * p[1] + frame[6] * p[2] + frame[9],
         frame[1] * p[0] + frame[4] * p[1] + frame[7] * p[2] + frame[10],
@@ -239,21 +419,21 @@ fn transform(frame: &[f64; 12], p: &[f64; 3]) -> [f64; 3] {
 }
 
 #[inline(always)]
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+pub(super) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 #[inline(always)]
-fn scale(a: &[f64; 3], s: f64) -> [f64; 3] {
+pub(super) fn scale(a: &[f64; 3], s: f64) -> [f64; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
 #[inline(always)]
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(super) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 #[inline(always)]
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+pub(super) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }

@@ -25,12 +25,15 @@
 //!
 //! Cost: `O(dof + Σ_s |dofs_s|²)` per configuration, no allocation.
 
+mod batch;
 mod compute;
 
 use faer::{MatMut, MatRef};
 
 use crate::error::{Result, RoutingError};
 use crate::routing::{Routing, Segment, check_shape};
+
+pub(crate) use batch::SegmentPlan;
 
 pub use compute::{compute_cable_geometry, compute_cable_geometry_from_kinematics};
 
@@ -70,6 +73,9 @@ pub struct RoutingData {
     v: Vec<[f64; 3]>,
     /// Scratch: `u · v_i`.
     g: Vec<f64>,
+    /// Scratch of the batched segment loop: length, `∂L/∂q` (two), Hessian (three) per entry of
+    /// the longest batch ([`SegmentPlan`]; empty without a plan).
+    batch: [Vec<f64>; 6],
 }
 
 impl RoutingData {
@@ -89,6 +95,9 @@ impl RoutingData {
             origins: vec![[0.0; 3]; routing.dof],
             v: vec![[0.0; 3]; routing.max_span],
             g: vec![0.0; routing.max_span],
+            batch: std::array::from_fn(|_| {
+                vec![0.0; routing.plan.as_ref().map_or(0, |p| p.longest)]
+            }),
         }
     }
 
@@ -234,6 +243,11 @@ impl RoutingData {
             ("routing workspace (segments)", routing.segments.len(), self.segment_lengths.len()),
             ("routing workspace (Hessian storage)", routing.hessian_len, self.hessians.len()),
             ("routing workspace (scratch)", routing.max_span, self.v.len()),
+            (
+                "routing workspace (batch scratch)",
+                routing.plan.as_ref().map_or(0, |p| p.longest),
+                self.batch[0].len(),
+            ),
         ] {
             if expected != got {
                 return Err(RoutingError::WorkspaceMismatch { what, expected, got });
@@ -251,12 +265,42 @@ pub struct SegmentHessians<'a> {
     hessians: &'a [f64],
 }
 
+/// One batch of [`SegmentHessians::batches`]: segments that cross the same DOFs.
+#[derive(Debug, Clone)]
+pub struct HessianBatch<'a> {
+    /// The DOFs every segment of the batch crosses.
+    pub dofs: std::ops::Range<usize>,
+    /// Each segment's cable, in routing order.
+    pub cables: &'a [usize],
+    /// The segments' `|dofs| × |dofs|` Hessian blocks (column-major), one after the other.
+    pub blocks: &'a [f64],
+}
+
 impl<'a> SegmentHessians<'a> {
     /// Segment `s`'s Hessian block `∂²L_s/∂q_i∂q_k` over its joints `segments()[s].dofs`
     /// (square, m/rad², column-major); `None` when `s` is out of range.
     #[inline]
     pub fn get(&self, s: usize) -> Option<MatRef<'a, f64>> {
         hessian_block(self.routing, self.hessians, s)
+    }
+
+    /// The blocks batch by batch, when the routing is batched ([`Routing::is_batched`]) and no
+    /// two batches cross the same DOF; `None` otherwise. A batch's segments cross the same
+    /// DOFs and come in routing order, so adding `f_c ·` each block batch by batch sums every
+    /// entry of `Σ_c f_c H_c` in the same order as [`SegmentHessians::iter`], reading the
+    /// blocks in storage order.
+    pub fn batches(&self) -> Option<impl Iterator<Item = HessianBatch<'a>> + 'a> {
+        let plan = self.routing.plan.as_ref().filter(|p| p.disjoint)?;
+        let hessians = self.hessians;
+        Some(plan.batches.iter().filter(|b| b.distal > b.proximal).map(move |b| {
+            let n = b.distal - b.proximal;
+            let o = plan.hessian.get(b.entries.start).copied().unwrap_or(0);
+            HessianBatch {
+                dofs: b.proximal..b.distal,
+                cables: plan.cable.get(b.entries.clone()).unwrap_or(&[]),
+                blocks: hessians.get(o..o + b.entries.len() * n * n).unwrap_or(&[]),
+            }
+        }))
     }
 
     /// Every segment with its Hessian block (column-major, `|dofs|²` entries, empty for a

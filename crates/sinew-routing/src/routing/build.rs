@@ -176,6 +176,7 @@ impl Routing {
             joint_groups: groups.to_vec(),
             cable_joint: out_cables.iter().map(|c| c.joint).collect(),
             stiffness: out_cables.iter().map(|c| c.stiffness).collect(),
+            plan: crate::geometry::SegmentPlan::new(&mut segments, out_cables.len()),
             cables: out_cables,
             segments,
             hessian_len,

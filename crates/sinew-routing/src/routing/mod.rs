@@ -136,6 +136,8 @@ pub struct Routing {
     pub(crate) joint_groups: Vec<Range<usize>>,
     pub(crate) cables: Vec<Cable>,
     pub(crate) segments: Vec<Segment>,
+    /// The segments batched by the bodies they join, when that pays (routed models).
+    pub(crate) plan: Option<crate::geometry::SegmentPlan>,
     pub(crate) cable_joint: Vec<usize>,
     pub(crate) stiffness: Vec<f64>,
     /// Total size of the segments' Hessian blocks.
@@ -213,6 +215,19 @@ impl Routing {
     /// The cables, ordered by joint.
     pub fn cables(&self) -> &[Cable] {
         &self.cables
+    }
+
+    /// Whether the geometry runs batched: segments grouped by the bodies they join, one
+    /// vectorised loop per group (routed models, where a joint is crossed by many cables), or
+    /// segment by segment (the decoupled model). Both give the same numbers bit for bit.
+    pub fn is_batched(&self) -> bool {
+        self.plan.is_some()
+    }
+
+    /// This routing with the segment-by-segment loop: the reference the batched loop is
+    /// tested against (the results are the same bit for bit, only slower).
+    pub fn unbatched(&self) -> Routing {
+        Routing { plan: None, ..self.clone() }
     }
 
     /// Every segment of every cable, cable by cable.
