@@ -85,6 +85,31 @@ impl KwGenerators {
         self.joints[k][2]
     }
 
+    /// The lower triangle (diagonal included) of `K_W` into `k_w`, a dof × dof column-major
+    /// buffer, column by column: the values of [`KwGenerators::fill_dense`] there, the strict
+    /// upper triangle untouched. With [`KwGenerators::is_symmetric`] this is all of `K_W`.
+    /// `O(dof²/2)`, no allocation.
+    ///
+    /// # Errors
+    /// [`StaticsError::DimensionMismatch`] unless `k_w.len()` is dof².
+    pub fn fill_lower(&self, k_w: &mut [f64]) -> Result<(), StaticsError> {
+        let n = self.len();
+        if k_w.len() != n * n {
+            return Err(StaticsError::DimensionMismatch {
+                what: "K_W",
+                expected: n * n,
+                got: k_w.len(),
+            });
+        }
+        for (i, column) in k_w.chunks_exact_mut(n.max(1)).enumerate().take(n) {
+            let a_i = self.a(i);
+            for (v, g) in column[i..].iter_mut().zip(&self.joints[i..]) {
+                *v = dot(a_i, g[2]);
+            }
+        }
+        Ok(())
+    }
+
     /// `K_W` (dof × dof) from the generators, column by column (eq. 9, (1) of the module
     /// docs). `O(dof²)`, no allocation.
     ///

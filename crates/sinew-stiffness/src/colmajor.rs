@@ -32,6 +32,11 @@ impl ColMajor {
         MatMut::from_column_major_slice_mut(&mut self.data, self.rows, self.cols)
     }
 
+    /// The entries, column by column.
+    pub(crate) fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.data
+    }
+
     #[inline(always)]
     pub(crate) fn at(&self, i: usize, j: usize) -> f64 {
         self.data[i + j * self.rows]

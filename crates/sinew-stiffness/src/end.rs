@@ -262,6 +262,11 @@ pub fn end_compliance(
 /// besides those two. Returns `Ok(false)` when the symmetric part is not positive definite
 /// (the caller reports the smallest eigenvalue).
 ///
+/// `k_q` must be exactly symmetric, as the pipeline builds it (its parts are written in
+/// symmetric pairs; `tests/routed.rs` checks it): when `K_W` is symmetric too (no moment in
+/// `F0`), only the lower triangle of `K_q + K_W` is formed, straight into the storage of the
+/// Cholesky factor.
+///
 /// # Errors
 /// [`StiffnessError::NonFinite`]; [`StiffnessError::DimensionMismatch`].
 pub(crate) fn end_compliance_generated(
@@ -277,11 +282,26 @@ pub(crate) fn end_compliance_generated(
         let expected = if j_x.nrows() != 6 { 6 } else { n };
         return Err(StiffnessError::DimensionMismatch { what: "J_x", expected, got });
     }
-    k_w.fill_dense(data.a.as_mut()).map_err(|_| StiffnessError::DimensionMismatch {
-        what: "K_W",
-        expected: n,
-        got: k_w.len(),
-    })?;
+    let mismatch =
+        |_| StiffnessError::DimensionMismatch { what: "K_W", expected: n, got: k_w.len() };
+    if k_w.is_symmetric() {
+        // K_q (symmetric by construction) + K_W (symmetric: no moment in F0) is its own
+        // symmetric part: its lower triangle, formed in place of the Cholesky factor, is all
+        // the solve needs (the same numbers as the general branch: 0.5 · (l + l) = l).
+        k_w.fill_lower(data.sym.as_mut_slice()).map_err(mismatch)?;
+        let mut finite = true;
+        for j in 0..n {
+            for (a, k) in data.sym.col_mut(j)[j..].iter_mut().zip(&k_q.col(j)[j..]) {
+                *a += k;
+                finite &= a.is_finite();
+            }
+        }
+        if !finite {
+            return Err(StiffnessError::NonFinite { what: "K_q + K_W" });
+        }
+        return Ok(factor_and_solve(j_x, true, data));
+    }
+    k_w.fill_dense(data.a.as_mut()).map_err(mismatch)?;
     // K_q + K_W in place, column by column.
     for j in 0..n {
         for (a, k) in data.a.col_mut(j).iter_mut().zip(k_q.col(j)) {

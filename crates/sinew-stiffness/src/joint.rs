@@ -96,20 +96,25 @@ pub(crate) fn joint_stiffness_in_blocks(
         });
     }
     if !layout.structured() {
-        zero_blocks(layout, controllable);
-        add_weighted_hessians(
-            routing,
-            geometry.segment_hessians(routing)?,
-            tensions,
-            controllable,
-        )?;
-        zero_blocks(layout, inherent);
-        plan.add_upper(geometry.jacobian()?, scratch, inherent)?;
+        let hessians = geometry.segment_hessians(routing)?;
+        match hessians.batches() {
+            // Each batch's block written once (the rest of K_c is never written: zero).
+            Some(batches) => {
+                add_weighted_hessians_batched(routing, batches, tensions, controllable)?
+            }
+            None => {
+                zero_blocks(layout, controllable);
+                add_weighted_hessians(routing, hessians, tensions, controllable)?;
+            }
+        }
+        // Every entry the tiles reach is written once; the others are never written (zero).
+        plan.set_upper(geometry.jacobian()?, scratch, inherent)?;
         mirror_upper(inherent.as_mut(), layout.blocks());
         for block in layout.blocks() {
             for j in block.clone() {
-                for i in block.clone() {
-                    *k_q.at_mut(i, j) = controllable.at(i, j) + inherent.at(i, j);
+                let (c, i) = (&controllable.col(j)[block.clone()], &inherent.col(j)[block.clone()]);
+                for ((q, c), i) in k_q.col_mut(j)[block.clone()].iter_mut().zip(c).zip(i) {
+                    *q = c + i;
                 }
             }
         }
@@ -289,10 +294,12 @@ fn add_weighted_hessians(
     Ok(())
 }
 
-/// [`add_weighted_hessians`] batch by batch (routed models): a batch's segments cross the same
-/// DOFs, so each entry of its block is one running sum over the batch's segments, kept in a
-/// register, in routing order (the same sums in the same order), reading the blocks and the
-/// cables in storage order.
+/// `Σ_c f_c H_c` batch by batch (routed models), each batch's diagonal block overwritten (the
+/// batches cross disjoint DOFs, and no segment reaches outside its batch's block, so the
+/// entries outside the blocks are never written and stay zero): a batch's segments cross the
+/// same DOFs, so each entry of its block is one running sum from zero over the batch's
+/// segments, kept in a register, in routing order (the sums of [`add_weighted_hessians`] on a
+/// zeroed matrix, in the same order), reading the blocks and the cables in storage order.
 fn add_weighted_hessians_batched<'a>(
     routing: &Routing,
     batches: impl Iterator<Item = HessianBatch<'a>>,
@@ -317,12 +324,7 @@ fn add_weighted_hessians_batched<'a>(
             });
         }
         if n == 2 {
-            let mut acc = [
-                out.col(lo)[lo],
-                out.col(lo)[lo + 1],
-                out.col(lo + 1)[lo],
-                out.col(lo + 1)[lo + 1],
-            ];
+            let mut acc = [0.0; 4];
             for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(4)) {
                 let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
                 for t in 0..4 {
@@ -332,6 +334,9 @@ fn add_weighted_hessians_batched<'a>(
             out.col_mut(lo)[lo..lo + 2].copy_from_slice(&acc[..2]);
             out.col_mut(lo + 1)[lo..lo + 2].copy_from_slice(&acc[2..]);
             continue;
+        }
+        for k in lo..lo + n {
+            out.col_mut(k)[lo..lo + n].fill(0.0);
         }
         for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(n * n)) {
             let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
@@ -346,14 +351,14 @@ fn add_weighted_hessians_batched<'a>(
     Ok(())
 }
 
-/// Height of the tiles of [`InherentPlan::add_upper`]: eight rows, two AVX registers.
+/// Height of the tiles of [`InherentPlan::set_upper`]: eight rows, two AVX registers.
 const LANES: usize = 8;
 
-/// Width of the tiles of [`InherentPlan::add_upper`]: four columns, so a tile's 32
+/// Width of the tiles of [`InherentPlan::set_upper`]: four columns, so a tile's 32
 /// accumulators fill eight AVX registers and each row of `J_c` loaded serves four columns.
 const COLUMNS: usize = 4;
 
-/// What [`InherentPlan::add_upper`] needs of the routing, computed once per model: for each
+/// What [`InherentPlan::set_upper`] needs of the routing, computed once per model: for each
 /// column `j` of `J_cᵀ K_l J_c`, the cables whose rows of `J_c` can be non-zero there and the
 /// first row they reach; and every cable's `k_c`.
 ///
@@ -372,7 +377,7 @@ pub(crate) struct InherentPlan {
     stiffness: Vec<f64>,
 }
 
-/// The workspace of [`InherentPlan::add_upper`]: `J_c` row by row (cable `c` at
+/// The workspace of [`InherentPlan::set_upper`]: `J_c` row by row (cable `c` at
 /// `rows[c · stride ..]`, zero-padded), and one column of `K_l J_c`.
 #[derive(Debug, Clone)]
 pub(crate) struct InherentScratch {
@@ -409,7 +414,9 @@ impl InherentPlan {
         }
     }
 
-    /// `out += J_cᵀ K_l J_c` on and above the diagonal (the caller mirrors it), in tiles of
+    /// `J_cᵀ K_l J_c` on and above the diagonal into `out` (the caller mirrors it): every entry
+    /// the plan can make non-zero is overwritten, the others are not touched (the caller keeps
+    /// them at zero: they are zero at every configuration). In tiles of
     /// [`LANES`] rows × [`COLUMNS`] columns accumulated in registers over the cables crossing
     /// any of the tile's columns (each row of `J_c` loaded once per tile serves four columns;
     /// compiled for AVX2 where present, through pulp's dispatch): entry `(i, j)` is
@@ -417,7 +424,7 @@ impl InherentPlan {
     /// [`add_inherent_upper`] (the extra terms, cables that do not cross `j` or `i`, are exact
     /// zeros; Rust does not fuse the multiply and the add, so AVX2 changes no rounding).
     /// `O(Σ_j |cables crossing j| · j)`, no allocation.
-    fn add_upper(
+    fn set_upper(
         &self,
         j_c: MatRef<'_, f64>,
         scratch: &mut InherentScratch,
@@ -451,7 +458,7 @@ impl InherentPlan {
     }
 }
 
-/// The loop of [`InherentPlan::add_upper`] over tiles of [`LANES`] rows × [`COLUMNS`]
+/// The loop of [`InherentPlan::set_upper`] over tiles of [`LANES`] rows × [`COLUMNS`]
 /// columns, as a pulp operation: `with_simd` is inlined into pulp's dispatch, so the loop is
 /// compiled for AVX2 where the processor has it. `J_c` row by row (`stride` apart), the plan's
 /// columns, the cables' stiffness, the weights' scratch and the output.
@@ -522,7 +529,7 @@ impl pulp::WithSimd for Tiles<'_> {
                     for l in 0..LANES {
                         let i = block + l;
                         if i >= first_row && i <= j {
-                            col[i] += acc[t][l];
+                            col[i] = acc[t][l];
                         }
                     }
                 }

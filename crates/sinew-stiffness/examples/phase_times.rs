@@ -1,0 +1,145 @@
+//! Wall-clock time of each phase of the routed pipeline (docs/performance.md, issue #16):
+//! `cargo run --release -p sinew-stiffness --example phase_times [JOINTS...]`. The benches'
+//! chain (weightless, unloaded, the same bent configuration); each phase is timed on its own,
+//! repeated, best of 7 runs.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::{Mat, Par};
+use nalgebra::{Vector3, Vector6};
+use sinew_robot::RobotData;
+use sinew_routing::{Order, PatternModel, RoutingData, compute_cable_geometry};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
+use sinew_testkit::cdhrm5;
+
+fn best(reps: usize, mut f: impl FnMut()) -> f64 {
+    (0..7)
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            t.elapsed().as_secs_f64() / reps as f64
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn main() {
+    if let Ok(order) = std::env::var("GEOMETRY_ONLY") {
+        // perf target: only the geometry at one order, for a while.
+        let order = match order.as_str() {
+            "lengths" => Order::Lengths,
+            "jacobian" => Order::Jacobian,
+            _ => Order::Hessians,
+        };
+        let (robot, routing) = cdhrm5::chain(100, PatternModel::Routed);
+        let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
+        let mut rdata = RobotData::new(&robot);
+        let mut geometry = RoutingData::new(&routing);
+        for _ in 0..20000 {
+            compute_cable_geometry(
+                &routing,
+                &robot,
+                &mut rdata,
+                &mut geometry,
+                black_box(&q),
+                order,
+            )
+            .unwrap();
+        }
+        return;
+    }
+    let args: Vec<usize> = std::env::args().skip(1).map(|s| s.parse().expect("JOINTS")).collect();
+    let sizes = if args.is_empty() { vec![5, 25, 50, 100] } else { args };
+    println!(
+        "{:>5} {:>12} {:>12} {:>12} {:>12}",
+        "DOF", "geometry", "joint level", "Cholesky", "pipeline"
+    );
+    for joints in sizes {
+        let (robot, routing) = cdhrm5::chain(joints, PatternModel::Routed);
+        let robot = robot.with_gravity(Vector3::zeros());
+        let n = robot.dof();
+        let q: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
+        let reps = (2_000_000 / (n * n)).max(20);
+        let mut rdata = RobotData::new(&robot);
+        let mut geometry = RoutingData::new(&routing);
+        let geo = best(reps, || {
+            compute_cable_geometry(
+                &routing,
+                &robot,
+                &mut rdata,
+                &mut geometry,
+                black_box(&q),
+                Order::Hessians,
+            )
+            .unwrap();
+        });
+        let lengths = best(reps, || {
+            compute_cable_geometry(
+                &routing,
+                &robot,
+                &mut rdata,
+                &mut geometry,
+                black_box(&q),
+                Order::Lengths,
+            )
+            .unwrap();
+        });
+        let jacobian = best(reps, || {
+            compute_cable_geometry(
+                &routing,
+                &robot,
+                &mut rdata,
+                &mut geometry,
+                black_box(&q),
+                Order::Jacobian,
+            )
+            .unwrap();
+        });
+        let fk = best(reps, || {
+            robot.forward_kinematics(&mut rdata, black_box(&q)).unwrap();
+        });
+        println!(
+            "      geometry by order: kinematics {:.2} µs, lengths {:.2} µs, + J_c {:.2} µs, + Hessians {:.2} µs",
+            fk * 1e6,
+            lengths * 1e6,
+            jacobian * 1e6,
+            geo * 1e6
+        );
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
+        let levels = vec![0.1; joints];
+        model.evaluate(&mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        let joint = best(reps, || {
+            model.joint_level(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
+        });
+        let k_q = data.k_q().to_owned();
+        let mut work: Mat<f64> = k_q.clone();
+        let mut buffer = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(
+            n,
+            Par::Seq,
+            Default::default(),
+        ));
+        let chol = best(reps, || {
+            work.copy_from(&k_q);
+            let stack = MemStack::new(&mut buffer);
+            let r = llt::factor::cholesky_in_place(
+                work.as_mut(),
+                Default::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            );
+            black_box(r.is_ok());
+        });
+        let pipe = best(reps, || {
+            model.evaluate(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
+        });
+        let us = |t: f64| format!("{:.2} µs", t * 1e6);
+        println!("{:>5} {:>12} {:>12} {:>12} {:>12}", n, us(geo), us(joint), us(chol), us(pipe));
+    }
+}
