@@ -36,11 +36,13 @@ fn main() {
             "jacobian" => Order::Jacobian,
             _ => Order::Hessians,
         };
-        let (robot, routing) = cdhrm5::chain(100, PatternModel::Routed);
-        let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
+        let joints: usize =
+            std::env::var("JOINTS").ok().and_then(|j| j.parse().ok()).unwrap_or(100);
+        let (robot, routing) = cdhrm5::chain(joints, PatternModel::Routed);
+        let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
         let mut rdata = RobotData::new(&robot);
         let mut geometry = RoutingData::new(&routing);
-        for _ in 0..20000 {
+        for _ in 0..(4_000_000 / joints / joints) {
             compute_cable_geometry(
                 &routing,
                 &robot,

@@ -43,8 +43,10 @@ pub struct EndStiffnessData {
     a: ColMajor,
     /// Symmetric part of `K_q + K_W`, then its Cholesky factor.
     sym: ColMajor,
-    /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6).
+    /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6), the non-symmetric case.
     x: Mat<f64>,
+    /// `L⁻¹ J_xᵀ`, row-major dof × 6, the symmetric case.
+    y: Vec<f64>,
     /// `C_x`, column-major 6 × 6.
     c_x: [f64; 36],
     /// `K_x`, column-major 6 × 6.
@@ -59,7 +61,6 @@ impl EndStiffnessData {
     pub fn new(dof: usize) -> EndStiffnessData {
         let req = StackReq::any_of(&[
             llt::factor::cholesky_in_place_scratch::<f64>(dof, Par::Seq, Default::default()),
-            llt::solve::solve_in_place_scratch::<f64>(dof, 6, Par::Seq),
             lu::factor::lu_in_place_scratch::<usize, f64>(dof, dof, Par::Seq, Default::default()),
             lu::solve::solve_in_place_scratch::<usize, f64>(dof, 6, Par::Seq),
         ]);
@@ -68,6 +69,7 @@ impl EndStiffnessData {
             a: ColMajor::zeros(dof, dof),
             sym: ColMajor::zeros(dof, dof),
             x: Mat::zeros(dof, 6),
+            y: vec![0.0; 6 * dof],
             c_x: [0.0; 36],
             k_x: [0.0; 36],
             perm: vec![0; dof],
@@ -323,10 +325,12 @@ pub(crate) fn end_compliance_generated(
     Ok(factor_and_solve(j_x, symmetric, data))
 }
 
-/// The Cholesky factorisation of `data.sym` (lower triangle: the symmetric part of
-/// `K_q + K_W`), which is the stability verdict; then `X = (K_q + K_W)⁻¹ J_xᵀ` with that factor
-/// when `symmetric`, else with the LU of `data.a` (`K_q + K_W`), and `C_x = J_x X`. `false`
-/// when the factorisation fails (not positive definite).
+/// The Cholesky factorisation `L Lᵀ` of `data.sym` (lower triangle: the symmetric part of
+/// `K_q + K_W`), which is the stability verdict; then `C_x` (eq. 19). When `symmetric`,
+/// `C_x = Yᵀ Y` with `Y = L⁻¹ J_xᵀ` ([`gram_of_forward_substitution`]: one triangular solve,
+/// and `C_x` symmetric by construction); else `X = (K_q + K_W)⁻¹ J_xᵀ` with the LU of `data.a`
+/// (`K_q + K_W`) and `C_x = J_x X`. `false` when the factorisation fails (not positive
+/// definite).
 fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffnessData) -> bool {
     let n = data.dof;
     let stack = MemStack::new(&mut data.buffer);
@@ -341,32 +345,38 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
     if !stable {
         return false;
     }
+    if symmetric {
+        // Y = J_xᵀ row by row (six values per joint), then L⁻¹ in place.
+        for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
+            for (r, v) in row.iter_mut().enumerate() {
+                *v = j_x[(r, k)];
+            }
+        }
+        gram_of_forward_substitution(&data.sym, &mut data.y, &mut data.c_x);
+        return true;
+    }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
     for c in 0..6 {
         for r in 0..n {
             data.x[(r, c)] = j_x[(c, r)];
         }
     }
-    if symmetric {
-        llt::solve::solve_in_place(data.sym.as_ref(), data.x.as_mut(), Par::Seq, stack);
-    } else {
-        let (_, perm) = lu::factor::lu_in_place(
-            data.a.as_mut(),
-            &mut data.perm,
-            &mut data.perm_inv,
-            Par::Seq,
-            stack,
-            Default::default(),
-        );
-        lu::solve::solve_in_place(
-            data.a.as_ref(),
-            data.a.as_ref(),
-            perm,
-            data.x.as_mut(),
-            Par::Seq,
-            stack,
-        );
-    }
+    let (_, perm) = lu::factor::lu_in_place(
+        data.a.as_mut(),
+        &mut data.perm,
+        &mut data.perm_inv,
+        Par::Seq,
+        stack,
+        Default::default(),
+    );
+    lu::solve::solve_in_place(
+        data.a.as_ref(),
+        data.a.as_ref(),
+        perm,
+        data.x.as_mut(),
+        Par::Seq,
+        stack,
+    );
     // C_x = J_x X: 36 dof multiply-adds in plain loops. (faer's matmul here returned with the
     // vector registers' upper halves dirty on the project machine, which slowed the scalar code
     // of the next evaluation threefold; see docs/performance.md.)
@@ -380,17 +390,42 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
         }
         out.copy_from_slice(&col);
     }
-    if symmetric {
-        // Exact symmetry, as the math says.
-        for j in 0..6 {
-            for i in j + 1..6 {
-                let s = 0.5 * (data.c_x[i + 6 * j] + data.c_x[j + 6 * i]);
-                data.c_x[i + 6 * j] = s;
-                data.c_x[j + 6 * i] = s;
+    true
+}
+
+/// `Y ← L⁻¹ Y` (forward substitution with the lower Cholesky factor `l`, the six right-hand
+/// sides of each row of the row-major dof × 6 `y` at once: column `k` of `L` updates the rows
+/// below `k` by six-wide multiply-adds), then `C_x = Yᵀ Y` (column-major 6 × 6, exactly
+/// symmetric): `J_x (L Lᵀ)⁻¹ J_xᵀ = (L⁻¹ J_xᵀ)ᵀ (L⁻¹ J_xᵀ)`. `dof²·3 + 36·dof` multiply-adds.
+fn gram_of_forward_substitution(l: &ColMajor, y: &mut [f64], c_x: &mut [f64; 36]) {
+    let n = l.cols();
+    for k in 0..n {
+        let column = &l.col(k)[k..];
+        let (head, tail) = y.split_at_mut((k + 1) * 6);
+        let y_k = &mut head[k * 6..];
+        for v in y_k.iter_mut() {
+            *v /= column[0];
+        }
+        for (row, &l_jk) in tail.chunks_exact_mut(6).zip(&column[1..]) {
+            for t in 0..6 {
+                row[t] -= l_jk * y_k[t];
             }
         }
     }
-    true
+    let mut gram = [[0.0; 6]; 6];
+    for row in y.chunks_exact(6) {
+        for a in 0..6 {
+            for b in 0..6 {
+                gram[a][b] += row[a] * row[b];
+            }
+        }
+    }
+    for a in 0..6 {
+        for b in 0..6 {
+            // Exactly symmetric: row[a]·row[b] and row[b]·row[a] are the same products.
+            c_x[a + 6 * b] = gram[a][b];
+        }
+    }
 }
 
 /// `C_x` and then `K_x = C_x⁻¹` (eq. 19) into `data`; read them with

@@ -38,6 +38,9 @@ pub(crate) struct SegmentPlan {
     pub(crate) proximal: [Vec<f64>; 3],
     /// Distal hole on its body.
     pub(crate) distal: [Vec<f64>; 3],
+    /// The constant length of each entry whose holes are on one body (zero for the others),
+    /// computed in the body frame as the segment-by-segment loop does.
+    pub(crate) rigid_length: Vec<f64>,
     /// The longest batch (the size of the workspace's scratch).
     pub(crate) longest: usize,
     /// Whether no two batches cross the same joint (then every entry of `Σ f_c H_c` is summed
@@ -135,12 +138,25 @@ impl SegmentPlan {
             proximal: [coordinate(0, false), coordinate(1, false), coordinate(2, false)],
             distal: [coordinate(0, true), coordinate(1, true), coordinate(2, true)],
             cable: order.iter().map(|&s| segments[s].cable).collect(),
+            rigid_length: order
+                .iter()
+                .map(|&s| rigid_length(&segments[s]).unwrap_or(0.0))
+                .collect(),
             hessian: order.iter().map(|&s| segments[s].hessian_offset).collect(),
             segment: order,
             longest,
             disjoint,
         })
     }
+}
+
+/// The constant length of a segment whose holes are on one body, in the body frame (the
+/// formula of the segment-by-segment loop); `None` for a segment across joints.
+pub(crate) fn rigid_length(seg: &Segment) -> Option<f64> {
+    seg.dofs.is_empty().then(|| {
+        let d = sub(&seg.distal_point, &seg.proximal_point);
+        dot(&d, &d).sqrt()
+    })
 }
 
 /// A batch's frames and joints: the proximal and distal body poses (`[R column-major, t]`)
@@ -160,8 +176,8 @@ pub(crate) struct BatchOut<'a> {
     pub(crate) h: [&'a mut [f64]; 3],
 }
 
-/// The batch's lengths, and for one or two joints (`joints` ≤ 2; the caller takes longer
-/// segments one by one) their derivatives. `hessians`: whether the Hessians are wanted.
+/// The batch's lengths and their derivatives, for one or two joints (`joints` ∈ {1, 2}; the
+/// caller takes longer segments one by one, and segments within one body from the plan). `hessians`: whether the Hessians are wanted.
 /// Inlined into the caller's pulp dispatch, so compiled with its vector instructions.
 #[inline(always)]
 pub(crate) fn run_batch(
@@ -173,7 +189,6 @@ pub(crate) fn run_batch(
     hessians: bool,
 ) {
     match (joints, hessians) {
-        (0, _) => kernel::<0, false>(frames, proximal, distal, out),
         (1, false) => kernel::<1, false>(frames, proximal, distal, out),
         (1, true) => kernel::<1, true>(frames, proximal, distal, out),
         (2, false) => kernel::<2, false>(frames, proximal, distal, out),
@@ -207,9 +222,6 @@ fn kernel<const N: usize, const H: bool>(
         let d = sub(&pb, &pa);
         let l = dot(&d, &d).sqrt();
         length[i] = l;
-        if N == 0 {
-            continue;
-        }
         let inv_length = 1.0 / l;
         let u = scale(&d, inv_length);
         let v0 = cross(&a0, &sub(&pb, &p0));

@@ -1,7 +1,7 @@
 //! The per-configuration computation: lengths, `J_c` and the segment Hessians (module docs
 //! of [`super`]).
 
-use super::batch::{BatchFrames, BatchOut, SegmentPlan, run_batch};
+use super::batch::{BatchFrames, BatchOut, SegmentPlan, rigid_length, run_batch};
 use super::{Order, RoutingData};
 use crate::error::{Result, RoutingError};
 use crate::routing::{MIN_SEGMENT_LENGTH, Routing, Segment};
@@ -40,7 +40,8 @@ pub fn compute_cable_geometry(
 /// # Math
 /// Frames: `o_` is the base frame. Joint `j` has the unit axis `a_j` through the point `p_j`.
 /// A segment joins a hole `o_p_A` on body `A` to a hole `o_p_B` on body `B > A`:
-/// `d = o_p_B − o_p_A`, `L = |d|`, `u = d / L`. Joints before `A` move both holes rigidly and
+/// `d = o_p_B − o_p_A`, `L = |d|`, `u = d / L` (both holes on one body: `L` is constant,
+/// computed in the body frame). Joints before `A` move both holes rigidly and
 /// joints from `B` on move neither, so `L` depends only on `q_A … q_{B−1}`. For `i, k` in that
 /// range, with `v_i = a_i × (o_p_B − p_i) = ∂d/∂q_i` and `∂²d/∂q_i∂q_k = a_min × v_max`:
 ///
@@ -161,6 +162,15 @@ fn one_segment(
     else {
         return Err(mismatch(dof));
     };
+    if let Some(length) = rigid_length(seg) {
+        // Both holes on one body: the length is constant, computed in the body frame.
+        if length.is_nan() || length < MIN_SEGMENT_LENGTH {
+            return Err(degenerate(routing, seg, length));
+        }
+        out.segment_lengths[s] = length;
+        out.lengths[seg.cable] += length;
+        return Ok(());
+    }
     let o_p_a = transform(frame_a, &seg.proximal_point);
     let o_p_b = transform(frame_b, &seg.distal_point);
     let d = sub(&o_p_b, &o_p_a);
@@ -170,7 +180,7 @@ fn one_segment(
     }
     out.segment_lengths[s] = length;
     out.lengths[seg.cable] += length;
-    if out.order == Order::Lengths || seg.dofs.is_empty() {
+    if out.order == Order::Lengths {
         return Ok(());
     }
     let inv_length = 1.0 / length;
@@ -272,6 +282,20 @@ fn batched_loop(
             continue;
         }
         let n = entries.len();
+        if joints == 0 {
+            // Both holes on one body: constant lengths (the plan's; the workspace's segment
+            // lengths were written when it was made), added to their cables' in order.
+            let rigid = &plan.rigid_length[entries.clone()];
+            match &batch.cables {
+                Some(range) => add(&mut out.lengths[range.clone()], rigid),
+                None => {
+                    for (&c, &length) in plan.cable[entries].iter().zip(rigid) {
+                        out.lengths[c] += length;
+                    }
+                }
+            }
+            continue;
+        }
         let [l, g0, g1, h00, h01, h11] = scratch.each_mut().map(|v| &mut v[..n]);
         run_batch(
             &BatchFrames { proximal, distal, axes: a, origins: p },
@@ -282,13 +306,15 @@ fn batched_loop(
             hessians,
         );
         let (segments, cables) = (&plan.segment[entries.clone()], &plan.cable[entries.clone()]);
-        if let Some(i) = l.iter().position(|&x| x.is_nan() || x < MIN_SEGMENT_LENGTH) {
+        // One vectorisable pass (NaN fails `>=`), the culprit searched only on failure.
+        if !l.iter().fold(true, |ok, &x| ok & (x >= MIN_SEGMENT_LENGTH)) {
+            let i = l.iter().position(|&x| !(x >= MIN_SEGMENT_LENGTH)).unwrap_or(0);
             return Err(degenerate(routing, &routing.segments[segments[i]], l[i]));
         }
         for (&s, &length) in segments.iter().zip(l.iter()) {
             out.segment_lengths[s] = length;
         }
-        let derivatives = out.order >= Order::Jacobian && joints > 0;
+        let derivatives = out.order >= Order::Jacobian;
         match &batch.cables {
             // Consecutive cables: whole slices of the lengths and of J_c's columns.
             Some(range) => {
@@ -313,7 +339,7 @@ fn batched_loop(
                 }
             }
         }
-        if hessians && joints > 0 {
+        if hessians {
             // The batch's blocks are consecutive (the plan lays them out in its order).
             let o = plan.hessian[entries.start];
             let blocks = &mut out.hessians[o..o + n * joints * joints];

@@ -9,7 +9,8 @@
 //! d = o_p_B − o_p_A,   L = |d|,   u = d / L.
 //! ```
 //!
-//! Joints before `A` move both holes rigidly and joints from `B` on move neither, so `L`
+//! (Both holes on one body: `L` is constant, and is computed in the body frame.) Joints before
+//! `A` move both holes rigidly and joints from `B` on move neither, so `L`
 //! depends only on `q_A … q_{B−1}`. For `i, k ∈ [A, B)`, with `v_i = a_i × (o_p_B − p_i)`
 //! (`∂d/∂q_i`) and `∂²d/∂q_i∂q_k = a_min × v_max` (kinematics of sinew-robot):
 //!
@@ -87,7 +88,12 @@ impl RoutingData {
             dof: routing.dof,
             computed: None,
             lengths: vec![0.0; m],
-            segment_lengths: vec![0.0; routing.segments.len()],
+            // Segments within one body have a constant length: written once, here.
+            segment_lengths: routing
+                .segments
+                .iter()
+                .map(|s| batch::rigid_length(s).unwrap_or(0.0))
+                .collect(),
             jacobian: vec![0.0; m * routing.dof],
             hessians: vec![0.0; routing.hessian_len],
             frames: vec![[0.0; 12]; routing.dof + 1],
