@@ -308,7 +308,7 @@ fn batched_loop(
         let (segments, cables) = (&plan.segment[entries.clone()], &plan.cable[entries.clone()]);
         // One vectorisable pass (NaN fails `>=`), the culprit searched only on failure.
         if !l.iter().fold(true, |ok, &x| ok & (x >= MIN_SEGMENT_LENGTH)) {
-            let i = l.iter().position(|&x| !(x >= MIN_SEGMENT_LENGTH)).unwrap_or(0);
+            let i = l.iter().position(|&x| x.is_nan() || x < MIN_SEGMENT_LENGTH).unwrap_or(0);
             return Err(degenerate(routing, &routing.segments[segments[i]], l[i]));
         }
         for (&s, &length) in segments.iter().zip(l.iter()) {
