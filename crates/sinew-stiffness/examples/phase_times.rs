@@ -1,7 +1,11 @@
 //! Wall-clock time of each phase of the routed pipeline (docs/performance.md, issue #16):
 //! `cargo run --release -p sinew-stiffness --example phase_times [JOINTS...]`. The benches'
 //! chain (weightless, unloaded, the same bent configuration); each phase is timed on its own,
-//! repeated, best of 7 runs.
+//! repeated, best of 7 runs: the geometry (forward kinematics, lengths, `J_c`, Hessians; also
+//! by order), the statics alone (`T0` and the tensions, from the geometry), the joint level
+//! (geometry, statics and `K_q`), faer's Cholesky of `K_q` alone, and the whole pipeline.
+//! `GEOMETRY_ONLY=lengths|jacobian|hessians [JOINTS=n]` instead loops over the geometry alone,
+//! a target for `perf record`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::hint::black_box;
@@ -13,6 +17,7 @@ use faer::{Mat, Par};
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::RobotData;
 use sinew_routing::{Order, PatternModel, RoutingData, compute_cable_geometry};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
 
@@ -58,8 +63,8 @@ fn main() {
     let args: Vec<usize> = std::env::args().skip(1).map(|s| s.parse().expect("JOINTS")).collect();
     let sizes = if args.is_empty() { vec![5, 25, 50, 100] } else { args };
     println!(
-        "{:>5} {:>12} {:>12} {:>12} {:>12}",
-        "DOF", "geometry", "joint level", "Cholesky", "pipeline"
+        "{:>5} {:>12} {:>12} {:>12} {:>12} {:>12}",
+        "DOF", "geometry", "statics", "joint level", "Cholesky", "pipeline"
     );
     for joints in sizes {
         let (robot, routing) = cdhrm5::chain(joints, PatternModel::Routed);
@@ -119,6 +124,20 @@ fn main() {
         let joint = best(reps, || {
             model.joint_level(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
         });
+        let statics = best(reps, || {
+            let ArmStiffnessData { robot: r, cables, statics, .. } = &mut data;
+            model
+                .statics()
+                .solve_with(
+                    model.robot(),
+                    r,
+                    cables,
+                    statics,
+                    &Vector6::zeros(),
+                    TensionChoice::Levels(&levels),
+                )
+                .unwrap();
+        });
         let k_q = data.k_q().to_owned();
         let mut work: Mat<f64> = k_q.clone();
         let mut buffer = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(
@@ -142,6 +161,14 @@ fn main() {
             model.evaluate(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
         });
         let us = |t: f64| format!("{:.2} µs", t * 1e6);
-        println!("{:>5} {:>12} {:>12} {:>12} {:>12}", n, us(geo), us(joint), us(chol), us(pipe));
+        println!(
+            "{:>5} {:>12} {:>12} {:>12} {:>12} {:>12}",
+            n,
+            us(geo),
+            us(statics),
+            us(joint),
+            us(chol),
+            us(pipe)
+        );
     }
 }

@@ -448,8 +448,18 @@ impl InherentPlan {
         // construction: J_c is exactly zero there at every configuration).
         for (i, (_, cables)) in self.columns.iter().enumerate() {
             let col = j_c.col(i);
-            for c in cables.clone() {
-                rows[c * stride + i] = col[c];
+            match col.try_as_col_major() {
+                Some(col) => {
+                    let col = &col.as_slice()[cables.clone()];
+                    for (row, &v) in rows[cables.start * stride..].chunks_mut(stride).zip(col) {
+                        row[i] = v;
+                    }
+                }
+                None => {
+                    for c in cables.clone() {
+                        rows[c * stride + i] = col[c];
+                    }
+                }
             }
         }
         let (rows, columns, stiffness) = (&*rows, &self.columns[..], &self.stiffness[..]);

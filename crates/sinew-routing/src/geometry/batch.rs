@@ -43,6 +43,11 @@ pub(crate) struct SegmentPlan {
     pub(crate) rigid_length: Vec<f64>,
     /// The longest batch (the size of the workspace's scratch).
     pub(crate) longest: usize,
+    /// Whether every entry of `J_c` has at most one segment (and no batch crosses more than
+    /// two joints): the batched loop then writes each entry once instead of adding into a
+    /// zeroed `J_c`, and the entries no segment reaches stay zero from the workspace's
+    /// construction.
+    pub(crate) single_writer: bool,
     /// Whether no two batches cross the same joint (then every entry of `Σ f_c H_c` is summed
     /// within one batch, in the same order batch by batch as segment by segment).
     pub(crate) disjoint: bool,
@@ -133,6 +138,16 @@ impl SegmentPlan {
                 .collect()
         };
         let longest = batches.iter().map(|b| b.entries.len()).max().unwrap_or(0);
+        let dof = segments.iter().map(|s| s.dofs.end).max().unwrap_or(0);
+        let mut written = vec![false; cables * dof];
+        let mut single_writer = batches.iter().all(|b| b.distal - b.proximal <= 2);
+        for seg in segments.iter() {
+            for k in seg.dofs.clone() {
+                let slot = &mut written[seg.cable * dof + k];
+                single_writer &= !*slot;
+                *slot = true;
+            }
+        }
         Some(SegmentPlan {
             batches,
             proximal: [coordinate(0, false), coordinate(1, false), coordinate(2, false)],
@@ -145,6 +160,7 @@ impl SegmentPlan {
             hessian: order.iter().map(|&s| segments[s].hessian_offset).collect(),
             segment: order,
             longest,
+            single_writer,
             disjoint,
         })
     }

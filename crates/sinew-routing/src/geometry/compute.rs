@@ -98,7 +98,10 @@ pub fn compute_cable_geometry_from_kinematics(
     }
 
     data.lengths.fill(0.0);
-    if order >= Order::Jacobian {
+    // With a plan whose every entry of J_c has at most one segment, each entry is written
+    // once (`0 + g`, as `+=` on zero would give) and the others are never written: no fill.
+    let single_writer = routing.plan.as_ref().is_some_and(|p| p.single_writer);
+    if order >= Order::Jacobian && !single_writer {
         data.jacobian.fill(0.0);
     }
     let m = data.cables;
@@ -320,9 +323,10 @@ fn batched_loop(
             Some(range) => {
                 add(&mut out.lengths[range.clone()], l);
                 if derivatives {
-                    add(&mut out.jacobian[lo * m..][range.clone()], g0);
+                    let write = if plan.single_writer { set } else { add };
+                    write(&mut out.jacobian[lo * m..][range.clone()], g0);
                     if joints == 2 {
-                        add(&mut out.jacobian[(lo + 1) * m..][range.clone()], g1);
+                        write(&mut out.jacobian[(lo + 1) * m..][range.clone()], g1);
                     }
                 }
             }
@@ -331,9 +335,15 @@ fn batched_loop(
                     let c = cables[i];
                     out.lengths[c] += l[i];
                     if derivatives {
-                        out.jacobian[c + lo * m] += g0[i];
+                        let zero = if plan.single_writer { 0.0 } else { out.jacobian[c + lo * m] };
+                        out.jacobian[c + lo * m] = zero + g0[i];
                         if joints == 2 {
-                            out.jacobian[c + (lo + 1) * m] += g1[i];
+                            let zero = if plan.single_writer {
+                                0.0
+                            } else {
+                                out.jacobian[c + (lo + 1) * m]
+                            };
+                            out.jacobian[c + (lo + 1) * m] = zero + g1[i];
                         }
                     }
                 }
@@ -425,6 +435,15 @@ fn segment_derivatives_any(
 fn add(target: &mut [f64], values: &[f64]) {
     for (t, v) in target.iter_mut().zip(values) {
         *t += v;
+    }
+}
+
+/// `target[i] = 0 + values[i]`: what `+=` on a zeroed target gives, bit for bit (`−0` becomes
+/// `+0`).
+#[inline(always)]
+fn set(target: &mut [f64], values: &[f64]) {
+    for (t, v) in target.iter_mut().zip(values) {
+        *t = 0.0 + v;
     }
 }
 
