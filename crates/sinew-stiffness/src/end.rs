@@ -352,7 +352,11 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
                 *v = j_x[(r, k)];
             }
         }
-        gram_of_forward_substitution(&data.sym, &mut data.y, &mut data.c_x);
+        let (l, y, c_x) = (&data.sym, &mut data.y[..], &mut data.c_x);
+        pulp::Arch::new().dispatch(
+            #[inline(always)]
+            || gram_of_forward_substitution(l, y, c_x),
+        );
         return true;
     }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
@@ -397,6 +401,7 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
 /// sides of each row of the row-major dof × 6 `y` at once: column `k` of `L` updates the rows
 /// below `k` by six-wide multiply-adds), then `C_x = Yᵀ Y` (column-major 6 × 6, exactly
 /// symmetric): `J_x (L Lᵀ)⁻¹ J_xᵀ = (L⁻¹ J_xᵀ)ᵀ (L⁻¹ J_xᵀ)`. `dof²·3 + 36·dof` multiply-adds.
+#[inline(always)]
 fn gram_of_forward_substitution(l: &ColMajor, y: &mut [f64], c_x: &mut [f64; 36]) {
     let n = l.cols();
     for k in 0..n {
