@@ -352,11 +352,7 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
                 *v = j_x[(r, k)];
             }
         }
-        let (l, y, c_x) = (&data.sym, &mut data.y[..], &mut data.c_x);
-        pulp::Arch::new().dispatch(
-            #[inline(always)]
-            || gram_of_forward_substitution(l, y, c_x),
-        );
+        pulp::Arch::new().dispatch(Gram { l: &data.sym, y: &mut data.y, c_x: &mut data.c_x });
         return true;
     }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
@@ -401,6 +397,23 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
 /// sides of each row of the row-major dof × 6 `y` at once: column `k` of `L` updates the rows
 /// below `k` by six-wide multiply-adds), then `C_x = Yᵀ Y` (column-major 6 × 6, exactly
 /// symmetric): `J_x (L Lᵀ)⁻¹ J_xᵀ = (L⁻¹ J_xᵀ)ᵀ (L⁻¹ J_xᵀ)`. `dof²·3 + 36·dof` multiply-adds.
+/// [`gram_of_forward_substitution`] as a pulp operation (`with_simd` is inlined into pulp's
+/// dispatch, so the loops are compiled for AVX2 where the processor has it).
+struct Gram<'a> {
+    l: &'a ColMajor,
+    y: &'a mut [f64],
+    c_x: &'a mut [f64; 36],
+}
+
+impl pulp::WithSimd for Gram<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        gram_of_forward_substitution(self.l, self.y, self.c_x);
+    }
+}
+
 #[inline(always)]
 fn gram_of_forward_substitution(l: &ColMajor, y: &mut [f64], c_x: &mut [f64; 36]) {
     let n = l.cols();
