@@ -132,9 +132,24 @@ pub fn distribute_tensions(
     let mut solve = |i: usize, tensions: &mut [f64]| -> Result<(), StaticsError> {
         let mut tau = Vector2::new(t0[2 * i], t0[2 * i + 1]);
         if layout.crossing {
-            for c in 3 * (i + 1)..3 * n {
-                tau[0] += jacobian[(c, 2 * i)] * tensions[c];
-                tau[1] += jacobian[(c, 2 * i + 1)] * tensions[c];
+            // The distal cables' torques, each component summed over the cables in order.
+            let distal = 3 * (i + 1)..3 * n;
+            for (k, t) in tau.iter_mut().enumerate() {
+                let column = jacobian.col(2 * i + k);
+                match column.try_as_col_major() {
+                    Some(column) => {
+                        let terms =
+                            column.as_slice()[distal.clone()].iter().zip(&tensions[distal.clone()]);
+                        for (j, f) in terms {
+                            *t += j * f;
+                        }
+                    }
+                    None => {
+                        for c in distal.clone() {
+                            *t += column[c] * tensions[c];
+                        }
+                    }
+                }
             }
         }
         let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);

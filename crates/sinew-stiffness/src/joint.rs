@@ -109,7 +109,7 @@ pub(crate) fn joint_stiffness_in_blocks(
         }
         // Every entry the tiles reach is written once; the others are never written (zero).
         plan.set_upper(geometry.jacobian()?, scratch, inherent)?;
-        mirror_upper(inherent.as_mut(), layout.blocks());
+        mirror_upper_in_place(inherent, layout.blocks());
         for block in layout.blocks() {
             for j in block.clone() {
                 let (c, i) = (&controllable.col(j)[block.clone()], &inherent.col(j)[block.clone()]);
@@ -551,6 +551,23 @@ impl pulp::WithSimd for Tiles<'_> {
 }
 
 /// Copy the strict upper triangle of each diagonal block `blocks` of `out` to its lower one.
+/// [`mirror_upper`] on the arm's own column-major storage (plain slices, no index checks per
+/// entry): column `j` below the diagonal from row `j` of the later columns.
+fn mirror_upper_in_place(out: &mut ColMajor, blocks: impl Iterator<Item = Range<usize>>) {
+    let n = out.rows();
+    let data = out.as_mut_slice();
+    for block in blocks {
+        for j in block.clone() {
+            // Entry (i, j), i > j, is (j, i): row j of the later columns.
+            let (head, tail) = data.split_at_mut((j + 1) * n);
+            let column = &mut head[j * n..];
+            for (i, later) in (j + 1..block.end).zip(tail.chunks_exact(n)) {
+                column[i] = later[j];
+            }
+        }
+    }
+}
+
 fn mirror_upper(mut out: MatMut<'_, f64>, blocks: impl Iterator<Item = Range<usize>>) {
     for block in blocks {
         for j in block.clone() {
