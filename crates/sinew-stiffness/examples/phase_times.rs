@@ -15,8 +15,8 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
 use faer::{Mat, Par};
 use nalgebra::{Vector3, Vector6};
-use sinew_robot::RobotData;
-use sinew_routing::{Order, PatternModel, RoutingData, compute_cable_geometry};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
@@ -31,6 +31,18 @@ fn best(reps: usize, mut f: impl FnMut()) -> f64 {
             t.elapsed().as_secs_f64() / reps as f64
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// One evaluation of the cable geometry up to `order`.
+fn geometry_at(
+    robot: &Robot,
+    routing: &Routing,
+    rdata: &mut RobotData,
+    geometry: &mut RoutingData,
+    q: &[f64],
+    order: Order,
+) {
+    compute_cable_geometry(routing, robot, rdata, geometry, black_box(q), order).unwrap();
 }
 
 fn main() {
@@ -48,15 +60,7 @@ fn main() {
         let mut rdata = RobotData::new(&robot);
         let mut geometry = RoutingData::new(&routing);
         for _ in 0..(4_000_000 / joints / joints) {
-            compute_cable_geometry(
-                &routing,
-                &robot,
-                &mut rdata,
-                &mut geometry,
-                black_box(&q),
-                order,
-            )
-            .unwrap();
+            geometry_at(&robot, &routing, &mut rdata, &mut geometry, &q, order);
         }
         return;
     }
@@ -74,39 +78,10 @@ fn main() {
         let reps = (2_000_000 / (n * n)).max(20);
         let mut rdata = RobotData::new(&robot);
         let mut geometry = RoutingData::new(&routing);
-        let geo = best(reps, || {
-            compute_cable_geometry(
-                &routing,
-                &robot,
-                &mut rdata,
-                &mut geometry,
-                black_box(&q),
-                Order::Hessians,
-            )
-            .unwrap();
-        });
-        let lengths = best(reps, || {
-            compute_cable_geometry(
-                &routing,
-                &robot,
-                &mut rdata,
-                &mut geometry,
-                black_box(&q),
-                Order::Lengths,
-            )
-            .unwrap();
-        });
-        let jacobian = best(reps, || {
-            compute_cable_geometry(
-                &routing,
-                &robot,
-                &mut rdata,
-                &mut geometry,
-                black_box(&q),
-                Order::Jacobian,
-            )
-            .unwrap();
-        });
+        let [lengths, jacobian, geo] =
+            [Order::Lengths, Order::Jacobian, Order::Hessians].map(|order| {
+                best(reps, || geometry_at(&robot, &routing, &mut rdata, &mut geometry, &q, order))
+            });
         let fk = best(reps, || {
             robot.forward_kinematics(&mut rdata, black_box(&q)).unwrap();
         });
