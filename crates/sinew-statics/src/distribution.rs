@@ -132,19 +132,24 @@ pub fn distribute_tensions(
     let mut solve = |i: usize, tensions: &mut [f64]| -> Result<(), StaticsError> {
         let mut tau = Vector2::new(t0[2 * i], t0[2 * i + 1]);
         if layout.crossing {
-            // The distal cables' torques, each component summed over the cables in order.
+            // The distal cables' torques, each component summed over the cables in order; the
+            // two components side by side (two independent chains of additions, which the
+            // processor overlaps; the same sums in the same order).
             let distal = 3 * (i + 1)..3 * n;
-            for (k, t) in tau.iter_mut().enumerate() {
-                let column = jacobian.col(2 * i + k);
-                match column.try_as_col_major() {
-                    Some(column) => {
-                        let terms =
-                            column.as_slice()[distal.clone()].iter().zip(&tensions[distal.clone()]);
-                        for (j, f) in terms {
-                            *t += j * f;
-                        }
+            let columns = (jacobian.col(2 * i), jacobian.col(2 * i + 1));
+            match (columns.0.try_as_col_major(), columns.1.try_as_col_major()) {
+                (Some(c0), Some(c1)) => {
+                    let (c0, c1) = (&c0.as_slice()[distal.clone()], &c1.as_slice()[distal.clone()]);
+                    let (mut t0, mut t1) = (tau[0], tau[1]);
+                    for ((j0, j1), f) in c0.iter().zip(c1).zip(&tensions[distal.clone()]) {
+                        t0 += j0 * f;
+                        t1 += j1 * f;
                     }
-                    None => {
+                    tau = Vector2::new(t0, t1);
+                }
+                _ => {
+                    for (k, t) in tau.iter_mut().enumerate() {
+                        let column = jacobian.col(2 * i + k);
                         for c in distal.clone() {
                             *t += column[c] * tensions[c];
                         }
