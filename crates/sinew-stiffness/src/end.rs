@@ -28,6 +28,7 @@ use faer::{Mat, MatRef, Par, Side};
 use nalgebra::Matrix3;
 use sinew_statics::KwGenerators;
 
+use crate::cholesky;
 use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
 
@@ -334,14 +335,18 @@ pub(crate) fn end_compliance_generated(
 fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffnessData) -> bool {
     let n = data.dof;
     let stack = MemStack::new(&mut data.buffer);
-    let stable = llt::factor::cholesky_in_place(
-        data.sym.as_mut(),
-        Default::default(),
-        Par::Seq,
-        stack,
-        Default::default(),
-    )
-    .is_ok();
+    let stable = if n <= cholesky::SMALL {
+        cholesky::cholesky_lower_in_place(data.sym.as_mut_slice(), n)
+    } else {
+        llt::factor::cholesky_in_place(
+            data.sym.as_mut(),
+            Default::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        )
+        .is_ok()
+    };
     if !stable {
         return false;
     }

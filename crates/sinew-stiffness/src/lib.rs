@@ -13,6 +13,7 @@
 #![deny(missing_docs)]
 
 mod arm;
+mod cholesky;
 mod colmajor;
 mod data;
 mod end;
