@@ -70,8 +70,8 @@ impl pulp::WithSimd for Crout<'_> {
                 }
             }
             let pivot = column[j];
-            // Written so that a NaN pivot also fails.
-            if !(pivot > 0.0) {
+            // A NaN pivot also fails.
+            if pivot.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return false;
             }
             let diagonal = pivot.sqrt();
