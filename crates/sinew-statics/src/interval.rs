@@ -178,6 +178,10 @@ pub fn tension_interval(
     let mut lambda_min = f64::NEG_INFINITY;
     let mut lambda_max = f64::INFINITY;
     let mut limiting = [0, 0];
+    // Where each cable reaches each limit along the null space: all six quotients at once (the
+    // divisions side by side, in vector instructions), then chosen by the sign of `null[k]`.
+    let at_min: [f64; 3] = std::array::from_fn(|k| (limits.f_min - particular[k]) / null[k]);
+    let at_max: [f64; 3] = std::array::from_fn(|k| (limits.f_max - particular[k]) / null[k]);
     for k in 0..3 {
         if null[k].abs() <= FORCE_CLOSURE_TOLERANCE {
             // The tension of cable k is f_p,k whatever λ: it must be within the limits.
@@ -187,11 +191,7 @@ pub fn tension_interval(
             }
             continue;
         }
-        let (lo, hi) = if null[k] > 0.0 {
-            ((limits.f_min - particular[k]) / null[k], (limits.f_max - particular[k]) / null[k])
-        } else {
-            ((limits.f_max - particular[k]) / null[k], (limits.f_min - particular[k]) / null[k])
-        };
+        let (lo, hi) = if null[k] > 0.0 { (at_min[k], at_max[k]) } else { (at_max[k], at_min[k]) };
         if lo > lambda_min {
             (lambda_min, limiting[0]) = (lo, k);
         }
