@@ -33,6 +33,11 @@ impl ColMajor {
     }
 
     /// The entries, column by column.
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// The entries, column by column.
     pub(crate) fn as_mut_slice(&mut self) -> &mut [f64] {
         &mut self.data
     }

@@ -109,15 +109,7 @@ pub(crate) fn joint_stiffness_in_blocks(
         }
         // Every entry the tiles reach is written once; the others are never written (zero).
         plan.set_upper(geometry.jacobian()?, scratch, inherent)?;
-        mirror_upper_in_place(inherent, layout.blocks());
-        for block in layout.blocks() {
-            for j in block.clone() {
-                let (c, i) = (&controllable.col(j)[block.clone()], &inherent.col(j)[block.clone()]);
-                for ((q, c), i) in k_q.col_mut(j)[block.clone()].iter_mut().zip(c).zip(i) {
-                    *q = c + i;
-                }
-            }
-        }
+        mirror_and_sum(controllable, inherent, k_q, layout.blocks());
         return Ok(());
     }
     let j_c = geometry.jacobian()?;
@@ -550,19 +542,29 @@ impl pulp::WithSimd for Tiles<'_> {
     }
 }
 
-/// Copy the strict upper triangle of each diagonal block `blocks` of `out` to its lower one.
-/// [`mirror_upper`] on the arm's own column-major storage (plain slices, no index checks per
-/// entry): column `j` below the diagonal from row `j` of the later columns.
-fn mirror_upper_in_place(out: &mut ColMajor, blocks: impl Iterator<Item = Range<usize>>) {
-    let n = out.rows();
-    let data = out.as_mut_slice();
+/// Within each diagonal block `blocks`: the strict upper triangle of `inherent` copied to its
+/// lower one ([`mirror_upper`] on the arm's own storage), and `K_q = K_c + K_i`, in one pass
+/// column by column (the lower part of column `j` of `K_i` from row `j` of the later columns,
+/// then the column of `K_q` while it is in cache). The same values as mirroring, then summing.
+fn mirror_and_sum(
+    controllable: &ColMajor,
+    inherent: &mut ColMajor,
+    k_q: &mut ColMajor,
+    blocks: impl Iterator<Item = Range<usize>>,
+) {
+    let n = inherent.rows();
+    let (k_c, k_i, k_q) = (controllable.as_slice(), inherent.as_mut_slice(), k_q.as_mut_slice());
     for block in blocks {
         for j in block.clone() {
-            // Entry (i, j), i > j, is (j, i): row j of the later columns.
-            let (head, tail) = data.split_at_mut((j + 1) * n);
+            // Entry (i, j), i > j, of K_i is (j, i): row j of the later columns.
+            let (head, tail) = k_i.split_at_mut((j + 1) * n);
             let column = &mut head[j * n..];
             for (i, later) in (j + 1..block.end).zip(tail.chunks_exact(n)) {
                 column[i] = later[j];
+            }
+            let (c, i) = (&k_c[j * n..][block.clone()], &column[block.clone()]);
+            for ((q, c), i) in k_q[j * n..][block.clone()].iter_mut().zip(c).zip(i) {
+                *q = c + i;
             }
         }
     }
