@@ -3,7 +3,8 @@
 //! chain (weightless, unloaded, the same bent configuration); each phase is timed on its own,
 //! repeated, best of 7 runs: the geometry (forward kinematics, lengths, `J_c`, Hessians; also
 //! by order), the statics alone (`T0` and the tensions, from the geometry), the joint level
-//! (geometry, statics and `K_q`), faer's Cholesky of `K_q` alone, and the whole pipeline.
+//! (geometry, statics and `K_q`), faer's Cholesky of `K_q` alone, and the whole pipeline; then
+//! the whole pipeline for the benches' 10-DOF case (cdhrm5 loaded) in both models.
 //! `GEOMETRY_ONLY=lengths|jacobian|hessians [JOINTS=n]` instead loops over the geometry alone,
 //! a target for `perf record`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -145,5 +146,20 @@ fn main() {
             us(chol),
             us(pipe)
         );
+    }
+    // The benches' 10-DOF case: cdhrm5 itself at the loaded pose (gravity, a tip force), both
+    // models, best of 7 like the rows above.
+    let robot = cdhrm5::robot();
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let pose = cdhrm5::LOADED_POSE;
+    for kind in cdhrm5::MODELS {
+        let routing = cdhrm5::routing(&robot, kind);
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
+        model.evaluate(&mut data, &pose, &f0, &[0.5; 5]).unwrap();
+        let pipe = best(20_000, || {
+            model.evaluate(&mut data, black_box(&pose), &f0, &[0.5; 5]).unwrap();
+        });
+        println!("cdhrm5 loaded, {kind:?}: pipeline {:.2} µs", pipe * 1e6);
     }
 }
