@@ -69,7 +69,7 @@ fn main() {
     let sizes = if args.is_empty() { vec![5, 25, 50, 100] } else { args };
     println!(
         "{:>5} {:>12} {:>12} {:>12} {:>12} {:>12}",
-        "DOF", "geometry", "statics", "joint level", "Cholesky", "pipeline"
+        "DOF", "geometry", "statics", "joint level", "faer chol", "pipeline"
     );
     for joints in sizes {
         let (robot, routing) = cdhrm5::chain(joints, PatternModel::Routed);

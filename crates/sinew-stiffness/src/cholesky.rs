@@ -15,8 +15,8 @@
 pub(crate) const SMALL: usize = 100;
 
 /// `L Lᵀ = A` in place on the lower triangle of the column-major `n × n` matrix `a` (the upper
-/// triangle is not written; its values are read but do not reach the result): `false` when a pivot is not positive (or not a
-/// number), i.e. `A` is not positive definite. No allocation.
+/// triangle is not written; its values are read but do not reach the result): `false` when a
+/// pivot is not positive (or not a number), i.e. `A` is not positive definite. No allocation.
 pub(crate) fn cholesky_lower_in_place(a: &mut [f64], n: usize) -> bool {
     if a.len() != n * n {
         return false;
@@ -59,15 +59,17 @@ impl pulp::WithSimd for Crout<'_> {
                 update::<32>(done, column, i, j, n);
                 i += 32;
             }
-            for width in [16, 8, 4] {
-                if i + width <= n {
-                    match width {
-                        16 => update::<16>(done, column, i, j, n),
-                        8 => update::<8>(done, column, i, j, n),
-                        _ => update::<4>(done, column, i, j, n),
-                    }
-                    i += width;
-                }
+            // The rest, a multiple of four below 32 rows.
+            if i + 16 <= n {
+                update::<16>(done, column, i, j, n);
+                i += 16;
+            }
+            if i + 8 <= n {
+                update::<8>(done, column, i, j, n);
+                i += 8;
+            }
+            if i + 4 <= n {
+                update::<4>(done, column, i, j, n);
             }
             let pivot = column[j];
             // A NaN pivot also fails.
