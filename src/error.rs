@@ -125,10 +125,13 @@ fn routing_kind(e: &RoutingError) -> ErrorKind {
 fn statics_kind(e: &StaticsError) -> ErrorKind {
     match e {
         // Whatever the reason: a rank-deficient joint block, lost force closure, or limits.
-        StaticsError::Infeasible { .. } | StaticsError::NoEquilibrium(_) => ErrorKind::Infeasible,
+        StaticsError::Infeasible { .. }
+        | StaticsError::NoEquilibrium(_)
+        | StaticsError::LevelsInfeasible(_) => ErrorKind::Infeasible,
         StaticsError::NonFiniteTorque { .. }
         | StaticsError::LevelsUnavailable(_)
-        | StaticsError::NotBalanced { .. }
+        | StaticsError::NotBalanced(_)
+        | StaticsError::NoPose
         | StaticsError::NoSuchJoint { .. }
         | StaticsError::InvalidLevel { .. }
         | StaticsError::UnsupportedRouting { .. }
@@ -146,7 +149,9 @@ fn stiffness_kind(e: &StiffnessError) -> ErrorKind {
         StiffnessError::Unstable { .. } => ErrorKind::Unstable,
         StiffnessError::RankDeficient { .. } => ErrorKind::RankDeficient,
         StiffnessError::NonFinite { .. } | StiffnessError::Eigen => ErrorKind::Numerical,
-        StiffnessError::DimensionMismatch { .. } => ErrorKind::Input,
+        StiffnessError::DimensionMismatch { .. }
+        | StiffnessError::InvalidDirection { .. }
+        | StiffnessError::StageMissing { .. } => ErrorKind::Input,
         StiffnessError::Statics(e) => statics_kind(e),
         StiffnessError::Robot(e) => robot_kind(e),
         StiffnessError::Routing(e) => routing_kind(e),
@@ -156,12 +161,11 @@ fn stiffness_kind(e: &StiffnessError) -> ErrorKind {
 
 fn indicator_kind(e: &IndicatorError) -> ErrorKind {
     match e {
-        IndicatorError::NonFinite { .. } => ErrorKind::Numerical,
         IndicatorError::Statics(e) => statics_kind(e),
         IndicatorError::Stiffness(e) => stiffness_kind(e),
         IndicatorError::Routing(e) => routing_kind(e),
         IndicatorError::Robot(e) => robot_kind(e),
-        // Joints, directions, grids, routings the probe cannot take: the caller's input.
+        // Joints, grids, routings the probe cannot take: the caller's input.
         _ => ErrorKind::Input,
     }
 }
@@ -271,7 +275,7 @@ mod tests {
             IndicatorError::GridTooSmall { points: 1, min: 2 }.into(),
             IndicatorError::GridRange { lower: 0.0, upper: 0.0 }.into(),
             IndicatorError::NotThreeCables { joint: 0, cables: 2 }.into(),
-            IndicatorError::InvalidDirection { direction: [0.0; 3] }.into(),
+            StiffnessError::InvalidDirection { direction: [0.0; 3] }.into(),
             Error::Other { message: "x.urdf: cannot read".into() },
         ];
         for e in cases {
@@ -308,7 +312,6 @@ mod tests {
         let cases: Vec<Error> = vec![
             StiffnessError::NonFinite { what: "K_q" }.into(),
             StiffnessError::Eigen.into(),
-            IndicatorError::NonFinite { what: "K_fd" }.into(),
             RoutingError::DegenerateSegment {
                 cable: "j1c1".into(),
                 segment: 0,

@@ -101,3 +101,65 @@ fn every_path_the_document_names_exists() {
     assert!(checked >= 20, "only {checked} paths found: is the document's format still parsed?");
     assert!(missing.is_empty(), "docs/ARCHITECTURE.md names paths that do not exist: {missing:?}");
 }
+
+/// The rows of the dependency table under the bird's-eye view: `| `crate` | `dep`, `dep` |`.
+fn drawn_dependencies(doc: &str) -> std::collections::BTreeMap<String, BTreeSet<String>> {
+    let start = doc.find("<!-- dependencies -->").expect("the dependency table's marker");
+    let end = doc[start..].find("<!-- /dependencies -->").expect("its end marker") + start;
+    doc[start..end]
+        .lines()
+        .filter(|l| l.starts_with("| `"))
+        .map(|l| {
+            let cells: Vec<&str> = l.split('|').collect();
+            let name = backticked(cells[1]).next().unwrap_or_default().to_owned();
+            let deps = backticked(cells[2]).map(str::to_owned).collect();
+            (name, deps)
+        })
+        .collect()
+}
+
+/// The normal (not dev, not build) dependencies on the workspace's own crates of the package
+/// whose manifest is `path`.
+fn normal_sinew_dependencies(path: &Path) -> (String, BTreeSet<String>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let manifest: toml::Table = text.parse().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let name = manifest["package"]["name"].as_str().expect("a package name").to_owned();
+    let deps = manifest
+        .get("dependencies")
+        .and_then(|d| d.as_table())
+        .map(|d| d.keys().filter(|k| k.starts_with("sinew")).cloned().collect())
+        .unwrap_or_default();
+    (name, deps)
+}
+
+#[test]
+fn every_dependency_between_our_crates_is_drawn_and_every_drawn_one_exists() {
+    let drawn = drawn_dependencies(&architecture());
+    let mut manifests: Vec<PathBuf> = std::fs::read_dir(root().join("crates"))
+        .expect("crates/ exists")
+        .flatten()
+        .map(|e| e.path().join("Cargo.toml"))
+        .filter(|p| p.is_file())
+        .collect();
+    manifests.push(root().join("xtask/Cargo.toml"));
+    manifests.push(root().join("Cargo.toml"));
+    let mut problems = Vec::new();
+    for manifest in &manifests {
+        let (name, deps) = normal_sinew_dependencies(manifest);
+        let Some(allowed) = drawn.get(&name) else {
+            problems.push(format!("{name}: no row in the dependency table"));
+            continue;
+        };
+        for d in deps.difference(allowed) {
+            problems.push(format!("{name} depends on {d}, which the table does not draw"));
+        }
+        for d in allowed.difference(&deps) {
+            problems.push(format!("the table draws {name} → {d}, which Cargo.toml does not have"));
+        }
+        if name != "xtask" && deps.contains("sinew-testkit") {
+            problems.push(format!("{name}: sinew-testkit is dev-only"));
+        }
+    }
+    assert_eq!(drawn.len(), manifests.len(), "rows for packages that do not exist: {drawn:?}");
+    assert!(problems.is_empty(), "{problems:#?}");
+}

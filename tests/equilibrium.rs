@@ -69,6 +69,7 @@ use sinew::statics::StaticsError;
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use sinew::paper::E4_Q;
+use sinew::statics::TensionChoice;
 use sinew_testkit::newton::Elastic;
 
 const ROBOT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/cdhrm5");
@@ -109,11 +110,13 @@ fn linearise(
 ) -> Option<Linear> {
     let model = ArmStiffness::new(robot, routing).unwrap();
     let mut data = ArmStiffnessData::new(&model);
-    match model.evaluate(&mut data, q, load, levels) {
+    match model.evaluate(&mut data, q, load, TensionChoice::Levels(levels)) {
         Ok(()) => {}
         Err(
             StiffnessError::Unstable { .. }
-            | StiffnessError::Statics(StaticsError::Infeasible { .. }),
+            | StiffnessError::Statics(
+                StaticsError::Infeasible { .. } | StaticsError::LevelsInfeasible(_),
+            ),
         ) => return None,
         Err(e) => panic!("at {q:?}, load {load:?}, levels {levels:?}: {e}"),
     }

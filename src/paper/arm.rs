@@ -10,7 +10,8 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 use crate::indicators::StiffnessEllipsoid;
 use crate::robot::Robot;
 use crate::routing::Routing;
-use crate::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
+use crate::statics::TensionChoice;
+use crate::stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome, StiffnessError};
 
 use super::claims::Claim;
 use super::experiments::{E4_CASES, E4_F0, E4_Q};
@@ -84,9 +85,10 @@ pub fn e4(
     let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_row_slice(&E4_F0);
     let mut joints = Vec::new();
-    let lowest = arm.joint_level(&mut data, &E4_Q, &f0, &[0.0; 5]);
-    // T0 is computed before the tensions, so it is there even when they are infeasible.
+    // One pose stage for every tension case below.
+    arm.set_pose(&mut data, &E4_Q, &f0)?;
     let t0 = data.statics.t0.clone();
+    let lowest = arm.set_tensions(&mut data, TensionChoice::Levels(&[0.0; 5]));
     if lowest.is_ok() {
         let base: Vec<[f64; 2]> = (0..5)
             .map(|i| data.joint_stiffness(i).map_or([0.0; 2], |k| [k[(0, 0)], k[(1, 1)]]))
@@ -95,7 +97,7 @@ pub fn e4(
         for i in 0..5 {
             let mut levels = [0.0; 5];
             levels[i] = 1.0;
-            let high = match arm.joint_level(&mut data, &E4_Q, &f0, &levels) {
+            let high = match arm.set_tensions(&mut data, TensionChoice::Levels(&levels)) {
                 Ok(()) => data.joint_stiffness(i).map_or([f64::NAN; 2], |k| [k[(0, 0)], k[(1, 1)]]),
                 Err(_) => [f64::NAN; 2],
             };
@@ -111,23 +113,29 @@ pub fn e4(
     for (name, raised) in E4_CASES {
         let levels = raised.map(|r| if r { 1.0 } else { baseline });
         let mut case = E4Case { name, levels, margin: None, k_fd: None, failure: None };
-        match arm.joint_level(&mut data, &E4_Q, &f0, &levels) {
-            Err(e) => case.failure = Some(format!("infeasible: {e}")),
-            Ok(()) => {
-                case.margin = Some(data.stability_margin()?);
-                match arm.evaluate(&mut data, &E4_Q, &f0, &levels) {
-                    Ok(()) => {
-                        let k = data.k_fd();
-                        case.k_fd = Some((k, StiffnessEllipsoid::new(&k)?));
-                    }
-                    Err(StiffnessError::Unstable { min_eigenvalue }) => {
-                        case.failure = Some(format!(
-                            "unstable equilibrium: K_q + K_W has the eigenvalue {} N m/rad",
-                            fixed(min_eigenvalue, 3)
-                        ));
-                    }
-                    Err(e) => case.failure = Some(e.to_string()),
-                }
+        if let Err(e) = arm.set_tensions(&mut data, TensionChoice::Levels(&levels)) {
+            case.failure = Some(format!("infeasible: {e}"));
+            cases.push(case);
+            continue;
+        }
+        arm.solve_end(&mut data)?;
+        let outcome = data
+            .outcome()
+            .ok_or(StiffnessError::StageMissing { needs: "solve_end", missing: "end stage" })?;
+        case.margin = Some(outcome.margin()?);
+        match outcome.end() {
+            EndOutcome::Stiff => {
+                let k = data.k_fd();
+                case.k_fd = Some((k, StiffnessEllipsoid::new(&k)?));
+            }
+            EndOutcome::Unstable { min_eigenvalue } => {
+                case.failure = Some(format!(
+                    "unstable equilibrium: K_q + K_W has the eigenvalue {} N m/rad",
+                    fixed(min_eigenvalue, 3)
+                ));
+            }
+            end @ EndOutcome::RankDeficient { .. } => {
+                case.failure = end.into_result().err().map(|e| e.to_string());
             }
         }
         cases.push(case);

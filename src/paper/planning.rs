@@ -8,10 +8,11 @@ use nalgebra::{Vector3, Vector6};
 use crate::planner::{Objective, Plan, PlanSettings, Planner, PlannerData, Requirements};
 use crate::robot::Robot;
 use crate::routing::Routing;
-use crate::stiffness::{ArmStiffness, ArmStiffnessData};
+use crate::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 
 use super::experiments::{E4_CASES, E4_F0, E4_PAPER_BASELINE, E4_Q, E5_MARGIN, E5_TRADEOFF_POINTS};
 use super::fixed;
+use crate::statics::TensionChoice;
 
 /// One distribution of E5: how it was chosen and what it gives.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,17 +55,22 @@ pub fn e5(robot: &Robot, routing: &Routing, model: &str) -> Result<E5, crate::Er
     let f0 = Vector6::from_row_slice(&E4_F0);
     let load = Vector3::new(f0[0], f0[1], f0[2]).normalize();
     let mut rows = Vec::new();
+    // One pose stage; a tension stage and the end stage per case.
+    arm.set_pose(&mut data, &E4_Q, &f0)?;
     for (name, raised) in E4_CASES {
         let levels = raised.map(|r| if r { 1.0 } else { E4_PAPER_BASELINE });
-        arm.joint_level(&mut data, &E4_Q, &f0, &levels)?;
-        let margin = data.stability_margin()?;
+        arm.set_tensions(&mut data, TensionChoice::Levels(&levels))?;
         let total = data.tensions().iter().sum();
-        let (k_load, k_min) = if margin > 0.0 {
-            arm.evaluate(&mut data, &E4_Q, &f0, &levels)?;
-            let k = data.k_fd();
-            (Some(load.dot(&(k * load))), Some(k.symmetric_eigen().eigenvalues.min()))
-        } else {
-            (None, None)
+        arm.solve_end(&mut data)?;
+        let outcome = data
+            .outcome()
+            .ok_or(StiffnessError::StageMissing { needs: "solve_end", missing: "end stage" })?;
+        let margin = outcome.margin()?;
+        let (k_load, k_min) = match outcome.k_fd() {
+            Some(k) if margin > 0.0 => {
+                (Some(load.dot(&(k * load))), Some(k.symmetric_eigen().eigenvalues.min()))
+            }
+            _ => (None, None),
         };
         rows.push(E5Row {
             name: format!("paper {name}"),

@@ -2,13 +2,12 @@
 
 use nalgebra::Vector6;
 use serde::Serialize;
-use sinew::indicators::StiffnessEllipsoid;
-use sinew::statics::TensionChoice;
-use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
+use sinew::statics::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 
-use crate::cli::{ArmArgs, Policy};
+use crate::cli::ArmArgs;
 use crate::error::{CliError, library_error};
-use crate::input::{check_limits, load, numbers_n, to_radians};
+use crate::input::{load, numbers_n, to_radians};
 use crate::output::{
     Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, na_vec, print_json,
     q_labels,
@@ -102,86 +101,63 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         &format!("angles (one per revolute joint, {joints} joints)"),
     )?;
     to_radians(&mut q, args.deg);
-    check_limits(robot, &q)?;
     let wrench = match &args.wrench {
         Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
         None => vec![0.0; 6],
     };
+    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?.checking_limits();
+    let mut data = ArmStiffnessData::new(&arm);
+    let f0 = Vector6::from_column_slice(&wrench);
+    // The pose stage (angles outside the limits refused, `--q: …`), once.
+    arm.set_pose(&mut data, &q, &f0).map_err(library_error)?;
     // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
-    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
-    let levels = match (&args.levels, args.policy) {
-        (Some(text), _) => Some(numbers_n(
+    let levels = match &args.levels {
+        Some(text) => Some(numbers_n(
             "--levels",
             text,
             joints,
             &format!("tension levels (one per joint, {joints} joints)"),
         )?),
-        (None, None) if arm.statics().has_levels() => Some(vec![0.0; joints]),
-        (None, _) => None,
+        None => None,
     };
-    let policy = args.policy.unwrap_or(Policy::LeastTotal).tension_policy();
-    let choice = match &levels {
-        Some(levels) => TensionChoice::Levels(levels),
-        None => TensionChoice::Policy(policy),
+    let by_default = levels.is_none() && args.policy.is_none();
+    let choice = match (&levels, args.policy) {
+        (Some(levels), _) => TensionChoice::Levels(levels),
+        (None, Some(policy)) => TensionChoice::Policy(policy.tension_policy()),
+        (None, None) => TensionChoice::Default,
     };
-    let mut data = ArmStiffnessData::new(&arm);
-    let f0 = Vector6::from_column_slice(&wrench);
+    arm.set_tensions(&mut data, choice).map_err(library_error)?;
+    let chosen = data.statics.chosen();
+    // The default in closed form is every joint at level 0.
+    let levels = match chosen {
+        Chosen::Levels => Some(levels.clone().unwrap_or_else(|| vec![0.0; joints])),
+        _ => None,
+    };
     let mut notes = Vec::new();
-    if args.levels.is_none() && args.policy.is_none() && levels.is_none() {
-        notes.push(
-            "tension levels need three cables per universal joint: the tensions are the policy least-total"
-                .to_owned(),
-        );
+    if by_default && chosen != Chosen::Levels {
+        notes.push(DEFAULT_POLICY_NOTE.to_owned());
     }
-    let outcome = arm.evaluate_with(&mut data, &q, &f0, choice);
-    let (stable, full_rank) = match outcome {
-        Ok(()) => (true, true),
-        Err(StiffnessError::Unstable { .. }) => {
-            notes.push(
-                "unstable equilibrium: K_q + K_W is not positive definite (min_eigenvalue < 0), \
-                 so C_x, K_x, K_fd and the ellipsoid do not exist"
-                    .to_owned(),
-            );
-            (false, false)
-        }
-        Err(e @ StiffnessError::RankDeficient { .. }) => {
-            notes.push(format!("{e}: k_x, k_fd and the ellipsoid are null"));
-            (true, false)
-        }
-        Err(e) => return Err(library_error(e)),
-    };
-    let min_eigenvalue = data.stability_margin().map_err(library_error)?;
-    let c_x = stable.then(|| faer_rows(data.compliance()));
-    // (C_x[0:3, 0:3])⁻¹: None where that block is singular (same tolerance as K_x's).
-    let k_translational = if stable { data.translational_stiffness() } else { None };
-    if stable && k_translational.is_none() {
-        notes.push(
-            "C_x[0:3, 0:3] is singular (the end cannot translate in some direction): \
-             k_translational is null"
-                .to_owned(),
-        );
-    }
-    let (k_x, k_fd, ellipsoid) = if full_rank {
-        let k_fd = data.k_fd();
-        let ellipsoid = StiffnessEllipsoid::new(&k_fd).map_err(library_error)?;
-        let e = EllipsoidOut {
-            eigenvalues: na_vec(&ellipsoid.eigenvalues),
-            directions: na_rows(&ellipsoid.directions.transpose()),
-            semi_axes: ellipsoid.semi_axes().map(|a| na_vec(&a)),
-            condition_number: ellipsoid.condition_number(),
-            volume: ellipsoid.volume(),
-            lambda_min: ellipsoid.lambda_min(),
-        };
-        if !ellipsoid.is_positive_definite() {
-            notes.push("K_fd is not positive definite: the ellipsoid's semi-axes, condition number and volume are null".to_owned());
-        }
-        (Some(faer_rows(data.stiffness())), Some(na_rows(&k_fd)), Some(e))
-    } else {
-        (None, None, None)
-    };
+    arm.solve_end(&mut data).map_err(library_error)?;
+    let outcome = data.outcome().ok_or_else(|| CliError::model("no end stage"))?;
+    let stable = outcome.is_stable();
+    notes.extend(outcome.notes().map_err(library_error)?.iter().map(|n| n.text("null")));
+    let min_eigenvalue = outcome.margin().map_err(library_error)?;
+    let c_x = outcome.compliance().map(faer_rows);
+    let k_translational = outcome.translational_stiffness();
+    let ellipsoid = outcome.ellipsoid().map_err(library_error)?.map(|e| EllipsoidOut {
+        eigenvalues: na_vec(&e.eigenvalues),
+        directions: na_rows(&e.directions.transpose()),
+        semi_axes: e.semi_axes().map(|a| na_vec(&a)),
+        condition_number: e.condition_number(),
+        volume: e.volume(),
+        lambda_min: e.lambda_min(),
+    });
+    let k_x = outcome.stiffness().map(faer_rows);
+    let k_fd = outcome.k_fd().map(|k| na_rows(&k));
     let cables: Vec<String> = routing.cables().iter().map(|c| c.name.clone()).collect();
-    let set = arm.equilibrium_set(&data).map_err(library_error)?;
+    let set = arm.equilibrium_set(&mut data).map_err(library_error)?;
     let force_closure = set.force_closure().map_err(library_error)?;
+    let null_space_dimension = set.dimension();
     let policy_objective = data.statics.distribution.as_ref().map(|d| d.objective);
     let level_list = levels.clone().unwrap_or_default();
     let intervals = data
@@ -212,12 +188,12 @@ pub fn run(args: &ArmArgs) -> Result<(), CliError> {
         gravity: [g.x, g.y, g.z],
         q,
         wrench,
-        policy: if levels.is_some() { "levels" } else { policy.name() },
+        policy: chosen.name(),
         levels,
         policy_objective,
         policy_iterations: data.statics.distribution.as_ref().map(|d| d.iterations),
         force_closure,
-        null_space_dimension: set.dimension(),
+        null_space_dimension,
         cables,
         t0: data.statics.t0.clone(),
         tensions: data.tensions().to_vec(),

@@ -7,7 +7,7 @@ use sinew_import::ImportOptions;
 
 use crate::cli::CasprArgs;
 use crate::error::{CliError, library_error};
-use crate::input::numbers_n;
+use crate::input::{numbers_n, one_number};
 
 /// Run `sinew import caspr`.
 pub fn caspr(args: &CasprArgs) -> Result<(), CliError> {
@@ -97,7 +97,7 @@ fn temporary_beside(out: &Path) -> Result<PathBuf, CliError> {
 fn options(args: &CasprArgs) -> Result<ImportOptions, CliError> {
     let one = |option: &str, text: &Option<String>, default: f64| -> Result<f64, CliError> {
         match text {
-            Some(t) => Ok(numbers_n(option, t, 1, "number")?[0]),
+            Some(t) => one_number(option, t),
             None => Ok(default),
         }
     };

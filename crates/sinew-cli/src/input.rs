@@ -97,6 +97,11 @@ pub fn numbers_n(option: &str, text: &str, count: usize, what: &str) -> Result<V
     Ok(values)
 }
 
+/// Exactly one number: an option that takes one value refuses a list (`--gap 1e-3,5`).
+pub fn one_number(option: &str, text: &str) -> Result<f64, CliError> {
+    Ok(numbers_n(option, text, 1, "number")?[0])
+}
+
 /// A 1-based universal joint number of the command line, as the 0-based index. Only the
 /// command line's numbering is checked here (a whole number from 1); whether the robot has
 /// that joint is the library's to say (`--joint N: joint N does not exist …`).
@@ -121,10 +126,4 @@ pub fn to_radians(values: &mut [f64], deg: bool) {
             *v = v.to_radians();
         }
     }
-}
-
-/// Check a full configuration against the joint limits, for the arm (whose evaluation does
-/// not): the library's error, `--q: joint …`.
-pub fn check_limits(robot: &Robot, q: &[f64]) -> Result<(), CliError> {
-    robot.check_limits(q).map_err(library_error)
 }

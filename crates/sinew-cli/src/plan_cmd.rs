@@ -9,7 +9,7 @@ use sinew::stiffness::ArmStiffness;
 
 use crate::cli::{PlanArgs, PlanObjective};
 use crate::error::{CliError, library_error};
-use crate::input::{check_limits, load, numbers, numbers_n, to_radians};
+use crate::input::{load, numbers_n, one_number, to_radians};
 use crate::output::{Fmt, Rows, Table, cartesian_labels, emit, matrix, na_rows, print_json};
 
 /// The JSON document of `sinew plan`.
@@ -69,10 +69,6 @@ fn joint_pairs(
         .collect()
 }
 
-fn one_number(option: &str, text: &str) -> Result<f64, CliError> {
-    Ok(numbers_n(option, text, 1, "number")?[0])
-}
-
 /// Run `sinew plan`.
 pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
@@ -80,7 +76,6 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let dof = robot.dof();
     let mut q = numbers_n("--q", &args.q, dof, &format!("angles (one per revolute joint, {dof})"))?;
     to_radians(&mut q, args.deg);
-    check_limits(robot, &q)?;
     let wrench = match &args.wrench {
         Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
         None => vec![0.0; 6],
@@ -142,11 +137,12 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         k_des,
     };
     let tolerance = match &args.gap {
-        Some(text) => numbers("--gap", text)?.first().copied().unwrap_or(DEFAULT_GAP),
+        Some(text) => one_number("--gap", text)?,
         None => DEFAULT_GAP,
     };
     let settings = PlanSettings { relative_gap: tolerance, ..PlanSettings::default() };
-    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?;
+    // The planner's one pose stage refuses angles outside the limits (`--q: …`).
+    let arm = ArmStiffness::new(robot, routing).map_err(library_error)?.checking_limits();
     let planner = Planner::new(arm);
     let mut data = PlannerData::new(&planner);
     let f0 = Vector6::from_column_slice(&wrench);

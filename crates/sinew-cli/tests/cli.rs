@@ -15,6 +15,7 @@ use sinew::indicators::{AngleGrid, JointProbe, StiffnessEllipsoid, sweep_joint};
 use sinew::paper::{E4_F0, E4_Q, e3_csv};
 use sinew::robot::{Robot, RobotDescription};
 use sinew::routing::Routing;
+use sinew::statics::TensionChoice;
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 use tempfile::TempDir;
 
@@ -266,7 +267,8 @@ fn library_arm(
 ) -> (ArmStiffnessData, Result<(), StiffnessError>) {
     let arm = ArmStiffness::new(robot, routing).unwrap();
     let mut data = ArmStiffnessData::new(&arm);
-    let outcome = arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), levels);
+    let outcome =
+        arm.evaluate(&mut data, q, &Vector6::from_column_slice(f0), TensionChoice::Levels(levels));
     (data, outcome)
 }
 
@@ -1310,3 +1312,54 @@ fn plan_refuses_bad_input_and_reports_the_unreachable() {
         }
     }
 }
+
+#[test]
+fn levels_that_overload_a_proximal_joint_say_so_and_suggest_a_policy() {
+    // Routed, E4's pose, every joint at level 1: the closed form fixes joints 4 and 5 first,
+    // and their cables overload joint 3; the safest policy holds the same load.
+    let q = "-25.714,-20,-20,-16.364,30,25.714,22.5,-12,-15,-18";
+    let base = ["arm", "--robot", CDHRM5_DIR, "--model", "routed", "--deg", "--q", q];
+    let with = |extra: &[&'static str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(&["--wrench", "0,5,0,0,0,0"]);
+        args.extend_from_slice(extra);
+        args
+    };
+    assert_fails(
+        &with(&["--levels", "1,1,1,1,1"]),
+        1,
+        &[
+            "joint 3 cannot hold torque",
+            "at these tension levels",
+            "the levels of joints 4, 5 fixed their cables' tensions first",
+            "choose a tension policy",
+            "--policy safest",
+        ],
+    );
+    let held = json(&with(&["--policy", "safest", "--json"]));
+    assert_eq!(held["policy"], "safest");
+    let [lo, hi] = [20.0, 600.0];
+    for f in held["tensions"].as_array().unwrap() {
+        let f = f.as_f64().unwrap();
+        assert!(lo < f && f < hi, "{f} N within the limits");
+    }
+}
+
+#[test]
+fn an_option_of_one_number_refuses_a_list() {
+    let q = "-25.714,-20,-20,-16.364,30,25.714,22.5,-12,-15,-18";
+    let plan = ["plan", "--robot", CDHRM5_DIR, "--deg", "--q", q, "--wrench", "0,5,0,0,0,0"];
+    for (option, value, says) in [
+        ("--gap", "1e-3,5", "expected 1 number, got 2"),
+        ("--margin", "1e-3,1", "expected 1 number, got 2"),
+        ("--budget", "900,", "`` is not a number"),
+        ("--k-min", "2 3", "is not a number"),
+    ] {
+        let mut args = plan.to_vec();
+        args.extend_from_slice(&["--objective", "volume", option, value]);
+        assert_fails(&args, 2, &[option, says]);
+    }
+}
+
+/// The embedded robot folder.
+const CDHRM5_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/cdhrm5");

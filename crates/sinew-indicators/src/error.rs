@@ -47,21 +47,6 @@ pub enum IndicatorError {
         /// Its revolute joints.
         dofs: usize,
     },
-    /// A stiffness matrix with a NaN or infinite entry.
-    #[error("{what} has a non-finite entry")]
-    NonFinite {
-        /// Which matrix.
-        what: &'static str,
-    },
-    /// A zero or non-finite direction for a directional stiffness.
-    #[error(
-        "direction [{}, {}, {}] is not a non-zero finite vector",
-        Compact(.direction[0]), Compact(.direction[1]), Compact(.direction[2])
-    )]
-    InvalidDirection {
-        /// The direction passed.
-        direction: [f64; 3],
-    },
     /// A sweep grid of fewer than [`crate::AngleGrid::MIN_POINTS`] points per axis.
     #[error("sweep grid of {points} points per axis: need at least {min}")]
     GridTooSmall {
@@ -99,7 +84,8 @@ pub enum IndicatorError {
 impl IndicatorError {
     /// Whether this is an infeasible load (the torque cannot be held within the limits).
     pub fn is_infeasible(&self) -> bool {
-        matches!(self, IndicatorError::Statics(e) if matches!(**e, StaticsError::Infeasible { .. }))
+        matches!(self, IndicatorError::Statics(e)
+            if matches!(**e, StaticsError::Infeasible { .. } | StaticsError::LevelsInfeasible(_)))
     }
 }
 

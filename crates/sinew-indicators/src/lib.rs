@@ -7,15 +7,15 @@
 //! - sweeps of those over a grid of the joint's angles, in parallel ([`sweep_joint`], the
 //!   paper's Fig. 5);
 //! - the end stiffness ellipsoid of `K_fd` (eq. 21): semi-axes, principal directions, `λ_min`,
-//!   condition number, volume, directional stiffness ([`StiffnessEllipsoid`]).
+//!   condition number, volume, directional stiffness ([`StiffnessEllipsoid`], defined in
+//!   sinew-stiffness with the evaluation outcome that gives it, re-exported here).
 #![deny(missing_docs)]
 
-mod ellipsoid;
 mod error;
 mod joint;
 mod sweep;
 
-pub use ellipsoid::StiffnessEllipsoid;
 pub use error::IndicatorError;
 pub use joint::{Indicator, JointProbe, JointStiffnessRange};
+pub use sinew_stiffness::StiffnessEllipsoid;
 pub use sweep::{AngleGrid, SweepCell, SweepMaps, sweep_joint};

@@ -9,6 +9,7 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 use sinew_indicators::{JointProbe, StiffnessEllipsoid};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 use sinew_testkit::{cdhrm5, config};
@@ -86,7 +87,7 @@ fn the_ellipsoid_allocates_nothing() {
     let arm = ArmStiffness::new(&robot, &routing).unwrap();
     let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    arm.evaluate(&mut data, &cdhrm5::LOADED_POSE, &f0, &[0.5; 5]).unwrap();
+    arm.evaluate(&mut data, &cdhrm5::LOADED_POSE, &f0, TensionChoice::Levels(&[0.5; 5])).unwrap();
     let k_x = data.stiffness();
     let k_fd = Matrix3::from_fn(|r, c| k_x[(r, c)]);
     let other = Matrix3::new(3.0, 0.5, 0.0, 0.5, 2.0, 0.1, 0.0, 0.1, 1.0);

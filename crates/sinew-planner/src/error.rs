@@ -23,7 +23,7 @@ pub enum PlanError {
         /// The argument.
         what: &'static str,
         /// What is wrong with it.
-        problem: String,
+        problem: InputProblem,
     },
     /// No tensions within the limits (and the budget) keep the arm stable with the margin
     /// asked for; `best` bounds every reachable margin from above.
@@ -120,5 +120,78 @@ impl From<sinew_stiffness::StiffnessError> for PlanError {
 impl From<sinew_routing::RoutingError> for PlanError {
     fn from(e: sinew_routing::RoutingError) -> Self {
         PlanError::Routing(Box::new(e))
+    }
+}
+
+/// What is wrong with an argument of a plan ([`PlanError::InvalidInput`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum InputProblem {
+    /// A vector with a NaN or infinite component.
+    NonFiniteComponent,
+    /// A direction that is not a finite unit vector.
+    NotUnitDirection,
+    /// A number that must be finite and positive.
+    NotPositive {
+        /// Its unit, with a leading space (or empty).
+        unit: &'static str,
+        /// Why, with a leading space (or empty).
+        reason: &'static str,
+    },
+    /// A number that must be finite and non-negative.
+    Negative {
+        /// Its unit, with a leading space (or empty).
+        unit: &'static str,
+    },
+    /// A number that must be finite.
+    NotFinite,
+    /// A matrix that must be symmetric positive definite.
+    NotSymmetricPositiveDefinite,
+    /// A joint the arm does not have (0-based; said from 1).
+    NoSuchJoint {
+        /// The joint asked for.
+        joint: usize,
+        /// The arm's joints.
+        joints: usize,
+    },
+    /// A held level of a joint the arm does not have, or outside `[0, 1]`.
+    BadFixedLevel {
+        /// The joint asked for (0-based; said from 1).
+        joint: usize,
+        /// The level asked for.
+        level: f64,
+        /// The arm's joints.
+        joints: usize,
+    },
+    /// Held levels on a routing without the decoupled closed form.
+    FixedLevelsNeedDecoupled,
+}
+
+impl std::fmt::Display for InputProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            InputProblem::NonFiniteComponent => write!(f, "has a NaN or infinite component"),
+            InputProblem::NotUnitDirection => write!(f, "must be a finite unit vector"),
+            InputProblem::NotPositive { unit, reason } => {
+                write!(f, "must be finite and > 0{unit}{reason}")
+            }
+            InputProblem::Negative { unit } => write!(f, "must be finite and ≥ 0{unit}"),
+            InputProblem::NotFinite => write!(f, "must be finite"),
+            InputProblem::NotSymmetricPositiveDefinite => {
+                write!(f, "must be symmetric positive definite")
+            }
+            InputProblem::NoSuchJoint { joint, joints } => {
+                write!(f, "joint {} does not exist: the arm has {joints} joints", joint + 1)
+            }
+            InputProblem::BadFixedLevel { joint, level, joints } => write!(
+                f,
+                "joint {} at level {level}: joints are 1 to {joints}, levels in [0, 1]",
+                joint + 1
+            ),
+            InputProblem::FixedLevelsNeedDecoupled => write!(
+                f,
+                "fixed tension levels need the paper's closed form in the decoupled model (three cables per universal joint, each crossing only its joint)"
+            ),
+        }
     }
 }

@@ -25,9 +25,11 @@
 mod bundle;
 mod error;
 mod pencil;
+mod phases;
 mod plan;
+mod problem;
+mod rows;
 
-pub use error::PlanError;
-pub use plan::{
-    DEFAULT_GAP, DEFAULT_MARGIN, Objective, Plan, PlanSettings, Planner, PlannerData, Requirements,
-};
+pub use error::{InputProblem, PlanError};
+pub use plan::{Planner, PlannerData};
+pub use problem::{DEFAULT_GAP, DEFAULT_MARGIN, Objective, Plan, PlanSettings, Requirements};

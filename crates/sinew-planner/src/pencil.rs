@@ -16,6 +16,8 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Side};
 use nalgebra::{Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
 
+use sinew_stiffness::compliance_inverse;
+
 use crate::error::PlanError;
 
 /// `A(λ) = A_0 + Σ λ_i A_i` with `J_x`, at one pose and load.
@@ -91,12 +93,8 @@ impl Pencil {
             (0..y.nrows()).map(|d| self.j_x[(r, d)] * y[(d, c)]).sum::<f64>()
         });
         let c_x = 0.5 * (c_x + c_x.transpose());
-        // K_x only where C_x is well conditioned (J_x of rank 6): an eigenvalue below 1e-12
-        // of the largest is a rank deficiency, not a stiffness.
-        let eigenvalues = c_x.symmetric_eigenvalues();
-        let full_rank = eigenvalues.min() > 1e-12 * eigenvalues.max();
-        let k_x =
-            if full_rank { c_x.try_inverse().map(|k| 0.5 * (k + k.transpose())) } else { None };
+        // K_x only where J_x has full rank: the pipeline's one test of it, on C_x.
+        let k_x = compliance_inverse(&c_x).ok().map(|k| 0.5 * (k + k.transpose()));
         if !c_x.iter().all(|v| v.is_finite()) {
             return None;
         }

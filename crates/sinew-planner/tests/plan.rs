@@ -38,7 +38,7 @@ fn value_at(
     requirements: &Requirements,
     tensions: &[f64],
 ) -> Option<f64> {
-    match arm.evaluate_with(data, q, f0, TensionChoice::Given(tensions)) {
+    match arm.evaluate(data, q, f0, TensionChoice::Given(tensions)) {
         Ok(()) | Err(StiffnessError::RankDeficient { .. }) => {}
         Err(_) => return None,
     }
@@ -89,8 +89,8 @@ impl Case {
     /// The equilibrium set at the pose (least-total tensions solved first).
     fn set(&self, arm: &ArmStiffness, data: &mut ArmStiffnessData) -> EquilibriumSet {
         let choice = TensionChoice::Policy(sinew_statics::TensionPolicy::LeastTotal);
-        arm.joint_level_with(data, &self.q, &self.f0, choice).unwrap();
-        arm.equilibrium_set(data).unwrap()
+        arm.evaluate_joints(data, &self.q, &self.f0, choice).unwrap();
+        arm.equilibrium_set(data).unwrap().clone()
     }
 }
 
@@ -348,7 +348,7 @@ fn the_answer_balances_the_load_within_the_limits_and_is_the_pipelines() {
             for (f, [lo, hi]) in plan.tensions.iter().zip(case.routing.cable_limits()) {
                 assert!(lo <= f && f <= hi, "{model:?}: {f} outside [{lo}, {hi}]");
             }
-            arm.evaluate_with(&mut data, &case.q, &case.f0, TensionChoice::Given(&plan.tensions))
+            arm.evaluate(&mut data, &case.q, &case.f0, TensionChoice::Given(&plan.tensions))
                 .unwrap();
             let t0 = &data.statics.t0;
             let j = data.cables.jacobian().unwrap();
@@ -368,7 +368,7 @@ fn the_answer_balances_the_load_within_the_limits_and_is_the_pipelines() {
             let k_fd = plan.k_fd.unwrap();
             assert!((data.k_fd() - k_fd).abs().max() <= 1e-9 * k_fd.abs().max());
             let levels = plan.levels.clone().expect("three cables per joint: levels");
-            arm.evaluate(&mut data, &case.q, &case.f0, &levels).unwrap();
+            arm.evaluate(&mut data, &case.q, &case.f0, TensionChoice::Levels(&levels)).unwrap();
             let diff = (data.k_fd() - k_fd).abs().max();
             assert!(
                 diff <= 1e-8 * k_fd.abs().max(),
@@ -390,7 +390,7 @@ fn with_every_a_i_psd_and_no_budget_the_optimum_is_the_top_of_every_interval() {
     let mut data = ArmStiffnessData::new(arm);
     let n = 5;
     let k_q_at = |data: &mut ArmStiffnessData, levels: &[f64]| {
-        arm.joint_level(data, &case.q, &case.f0, levels).unwrap();
+        arm.evaluate_joints(data, &case.q, &case.f0, TensionChoice::Levels(levels)).unwrap();
         data.k_q().to_owned()
     };
     let bottom = k_q_at(&mut data, &[0.0; 5]);
@@ -413,7 +413,7 @@ fn with_every_a_i_psd_and_no_budget_the_optimum_is_the_top_of_every_interval() {
                 &PlanSettings::default(),
             )
             .unwrap();
-        arm.evaluate(&mut data, &case.q, &case.f0, &[1.0; 5]).unwrap();
+        arm.evaluate(&mut data, &case.q, &case.f0, TensionChoice::Levels(&[1.0; 5])).unwrap();
         let top = data.tensions().to_vec();
         let requirements = Requirements::default();
         let v =
@@ -520,7 +520,7 @@ fn the_concavity_the_method_relies_on_holds_on_random_segments() {
         }
         // The stability margin too.
         let margin = |f: &[f64], data: &mut ArmStiffnessData| {
-            let _ = arm.joint_level_with(data, &case.q, &case.f0, TensionChoice::Given(f));
+            let _ = arm.evaluate_joints(data, &case.q, &case.f0, TensionChoice::Given(f));
             data.stability_margin().unwrap()
         };
         let (ma, mb, mm) = (margin(&fa, &mut data), margin(&fb, &mut data), margin(&fm, &mut data));
@@ -647,7 +647,7 @@ fn fixed_levels_are_held_and_need_the_decoupled_closed_form() {
     let mut at = levels.clone();
     at[2] = 0.25;
     at[4] = 1.0;
-    arm.joint_level(&mut data, &case.q, &case.f0, &at).unwrap();
+    arm.evaluate_joints(&mut data, &case.q, &case.f0, TensionChoice::Levels(&at)).unwrap();
     for c in case.routing.cables_of_joint(2).chain(case.routing.cables_of_joint(4)) {
         let (a, b) = (plan.tensions[c], data.tensions()[c]);
         assert!((a - b).abs() <= 1e-6 * b, "cable {c}: {a} vs {b}");
@@ -657,4 +657,43 @@ fn fixed_levels_are_held_and_need_the_decoupled_closed_form() {
     let mut pdata = PlannerData::new(&planner);
     let err = planner.plan(&mut pdata, &routed.q, &routed.f0, objective, &held, &s).unwrap_err();
     assert!(matches!(err, PlanError::InvalidInput { what: "fixed_level", .. }), "{err}");
+}
+
+#[test]
+fn a_plan_at_one_pose_runs_exactly_one_pose_stage() {
+    // Before the pose stage existed, a plan ran the pipeline's geometry, T0 and K_W three times
+    // (least-total tensions, safest tensions, the answer's evaluation) and four with held
+    // levels. The workspace counts its pose stages: one per plan, whatever the objective, the
+    // model or the requirements.
+    let s = PlanSettings::default();
+    let objectives = [
+        Objective::StiffnessAlong(Vector3::y()),
+        Objective::ComplianceAlong(Vector3::new(0.6, 0.8, 0.0)),
+        Objective::MinStiffness,
+        Objective::Volume,
+        Objective::LeastTension,
+    ];
+    for model in [PatternModel::Decoupled, PatternModel::Routed] {
+        let case = cdhrm5_case(model);
+        let planner = case.planner();
+        let mut pdata = PlannerData::new(&planner);
+        let mut plans = 0;
+        for objective in objectives {
+            let mut requirements = Requirements::default();
+            if objective == Objective::LeastTension {
+                requirements.k_min = Some(3.0);
+            }
+            let before = pdata.stiffness().pose_stages();
+            planner.plan(&mut pdata, &case.q, &case.f0, objective, &requirements, &s).unwrap();
+            assert_eq!(pdata.stiffness().pose_stages() - before, 1, "{model:?} {objective:?}");
+            plans += 1;
+        }
+        if model == PatternModel::Decoupled {
+            let held = Requirements { fixed_levels: vec![(2, 0.25)], ..Requirements::default() };
+            let objective = Objective::MinStiffness;
+            planner.plan(&mut pdata, &case.q, &case.f0, objective, &held, &s).unwrap();
+            plans += 1;
+        }
+        assert_eq!(pdata.stiffness().pose_stages(), plans, "{model:?}");
+    }
 }

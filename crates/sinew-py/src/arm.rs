@@ -9,8 +9,8 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use sinew::indicators::StiffnessEllipsoid;
 use sinew::planner::{Objective, PlanSettings, Planner, PlannerData, Requirements};
-use sinew::statics::{TensionChoice, TensionPolicy};
-use sinew::stiffness::{ArmStiffnessData, StiffnessError, stability_margin};
+use sinew::statics::{Chosen, TensionChoice, TensionPolicy};
+use sinew::stiffness::{ArmStiffnessData, OutcomeNote, stability_margin};
 
 use crate::batch::{BatchChoice, evaluate_many};
 use crate::convert::{finite, matrix, na2, reshape, vec1, vector};
@@ -253,10 +253,7 @@ impl ArmResult {
         if let Some(e) = self.ellipsoid()?
             && e.semi_axes.is_none()
         {
-            notes.push(
-                "K_fd is not positive definite: the ellipsoid's semi-axes, condition number and volume are None"
-                    .to_owned(),
-            );
+            notes.push(OutcomeNote::IndefiniteKfd.text("None"));
         }
         Ok(notes)
     }
@@ -367,8 +364,9 @@ impl ArmStiffness {
     /// The model of `robot` with `routing`.
     #[new]
     fn new(robot: &Robot, routing: &Routing) -> PyResult<ArmStiffness> {
-        let arm =
-            sinew::stiffness::ArmStiffness::new(&robot.inner, &routing.inner).map_err(library)?;
+        let arm = sinew::stiffness::ArmStiffness::new(&robot.inner, &routing.inner)
+            .map_err(library)?
+            .checking_limits();
         let data = Mutex::new(ArmStiffnessData::new(&arm));
         Ok(ArmStiffness { arm, data, planner: OnceLock::new() })
     }
@@ -415,7 +413,6 @@ impl ArmStiffness {
     ) -> PyResult<ArmResult> {
         let arm = &self.arm;
         let q = vector(q, "q", Some(arm.dof()))?;
-        arm.robot().check_limits(&q).map_err(library)?;
         let f0 = wrench_of(wrench)?;
         let joints = arm.robot().joint_count();
         let given = [levels.is_some(), policy.is_some(), tensions.is_some()];
@@ -424,23 +421,17 @@ impl ArmStiffness {
         }
         let levels = match levels {
             Some(l) => Some(vector(l, "levels", Some(joints))?),
-            None if policy.is_none() && tensions.is_none() && arm.statics().has_levels() => {
-                Some(vec![0.0; joints])
-            }
             None => None,
         };
         let given_tensions = match tensions {
             Some(t) => Some(vector(t, "tensions", Some(arm.routing().cable_count()))?),
             None => None,
         };
-        let chosen_policy = match policy {
-            Some(name) => self::policy(name)?,
-            None => TensionPolicy::LeastTotal,
-        };
-        let (choice, policy_name) = match (&levels, &given_tensions) {
-            (Some(l), _) => (TensionChoice::Levels(l), "levels"),
-            (None, Some(t)) => (TensionChoice::Given(t), "given"),
-            (None, None) => (TensionChoice::Policy(chosen_policy), chosen_policy.name()),
+        let choice = match (&levels, &given_tensions, policy) {
+            (Some(l), _, _) => TensionChoice::Levels(l),
+            (None, Some(t), _) => TensionChoice::Given(t),
+            (None, None, Some(name)) => TensionChoice::Policy(self::policy(name)?),
+            (None, None, None) => TensionChoice::Default,
         };
         let mut fresh;
         let mut guard = self.data.try_lock();
@@ -451,23 +442,20 @@ impl ArmStiffness {
                 &mut fresh
             }
         };
-        let mut notes = Vec::new();
-        let (stable, full_rank) = match arm.evaluate_with(data, &q, &f0, choice) {
-            Ok(()) => (true, true),
-            Err(StiffnessError::Unstable { .. }) => {
-                notes.push(
-                    "unstable equilibrium: K_q + K_W is not positive definite (min_eigenvalue < 0), \
-                     so C_x, K_x, K_fd and the ellipsoid do not exist"
-                        .to_owned(),
-                );
-                (false, false)
-            }
-            Err(e @ StiffnessError::RankDeficient { .. }) => {
-                notes.push(format!("{e}: k_x, k_fd and the ellipsoid are None"));
-                (true, false)
-            }
-            Err(e) => return Err(library(e)),
+        let end = arm
+            .evaluate_joints(data, &q, &f0, choice)
+            .and_then(|()| arm.solve_end(data))
+            .map_err(library)?;
+        let (stable, full_rank) = (end.is_stable(), end.has_end_stiffness());
+        // The ellipsoid's note is added when the ellipsoid is read (`notes`).
+        let notes = end.note().iter().map(|n| n.text("None")).collect();
+        let chosen = data.statics.chosen();
+        // The default in closed form is every joint at level 0.
+        let levels = match chosen {
+            Chosen::Levels => Some(levels.unwrap_or_else(|| vec![0.0; joints])),
+            _ => None,
         };
+        let policy_name = chosen.name();
         let k_fd = full_rank.then(|| data.k_fd());
         let result = ArmResult {
             q: LazyArray::vector(&q),
@@ -522,8 +510,7 @@ impl ArmStiffness {
             (Some(_), Some(_)) => return Err(input("give at most one of levels and policy")),
             (Some(l), None) => BatchChoice::Levels(vector(l, "levels", Some(joints))?),
             (None, Some(p)) => BatchChoice::Policy(self::policy(p)?),
-            (None, None) if arm.statics().has_levels() => BatchChoice::Levels(vec![0.0; joints]),
-            (None, None) => BatchChoice::Policy(TensionPolicy::LeastTotal),
+            (None, None) => BatchChoice::Default,
         };
         let batch = py.detach(|| evaluate_many(arm, &q, &f0, &choice));
         if let Some((_, kind, message)) = batch.errors.first()
@@ -573,8 +560,8 @@ impl ArmStiffness {
         gap: f64,
     ) -> PyResult<PlanResult> {
         let arm = &self.arm;
+        // The planner's pose stage refuses angles outside the limits.
         let q = vector(q, "q", Some(arm.dof()))?;
-        arm.robot().check_limits(&q).map_err(library)?;
         let f0 = wrench_of(wrench)?;
         let direction = match direction {
             Some(d) => {

@@ -7,7 +7,7 @@ use nalgebra::Vector6;
 use rayon::prelude::*;
 use sinew::ErrorKind;
 use sinew::statics::{TensionChoice, TensionPolicy};
-use sinew::stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
+use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 
 /// How every row's tensions are chosen.
 #[derive(Debug, Clone, PartialEq)]
@@ -16,6 +16,8 @@ pub enum BatchChoice {
     Levels(Vec<f64>),
     /// A policy over the equilibrium set.
     Policy(TensionPolicy),
+    /// The library's default ([`TensionChoice::Default`]).
+    Default,
 }
 
 /// The results of a batch, row-major; a failed row is NaN everywhere, `ok` false and its
@@ -148,23 +150,22 @@ fn row(
     let fail = |out: &mut Fixed, e: sinew::Error| {
         out.error = Some(crate::errors::message(e));
     };
-    if let Err(e) = arm.robot().check_limits(q) {
-        return fail(out, e.into());
-    }
     let choice = match choice {
         BatchChoice::Levels(levels) => TensionChoice::Levels(levels),
         BatchChoice::Policy(p) => TensionChoice::Policy(*p),
+        BatchChoice::Default => TensionChoice::Default,
     };
-    let (stable, full_rank) = match arm.evaluate_with(data, q, f0, choice) {
-        Ok(()) => (true, true),
-        Err(StiffnessError::Unstable { .. }) => (false, false),
-        Err(StiffnessError::RankDeficient { .. }) => (true, false),
+    // The arm refuses angles outside the limits and NaN in its pose stage.
+    let end = match arm.evaluate_joints(data, q, f0, choice).and_then(|()| arm.solve_end(data)) {
+        Ok(end) => end,
         Err(e) => return fail(out, e.into()),
     };
-    match data.stability_margin() {
+    let Some(outcome) = data.outcome() else { return };
+    match outcome.margin() {
         Ok(m) => out.min_eigenvalue = m,
         Err(e) => return fail(out, e.into()),
     }
+    let (stable, full_rank) = (end.is_stable(), end.has_end_stiffness());
     out.ok = true;
     out.stable = stable;
     if stable {

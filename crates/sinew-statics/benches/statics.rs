@@ -29,7 +29,7 @@ fn bench_policies(c: &mut Criterion) {
     use nalgebra::Vector6;
     use sinew_robot::RobotData;
     use sinew_routing::{Order, PatternModel, RoutingData, compute_cable_geometry};
-    use sinew_statics::{ArmStatics, TensionChoice, TensionPolicy};
+    use sinew_statics::{ArmStatics, EquilibriumSet, TensionChoice, TensionPolicy};
     use sinew_testkit::cdhrm5;
 
     for model in cdhrm5::MODELS {
@@ -48,7 +48,15 @@ fn bench_policies(c: &mut Criterion) {
             PatternModel::Routed => "routed",
         };
         c.bench_function(&format!("equilibrium set, cdhrm5 {name}"), |b| {
-            b.iter(|| statics.equilibrium_set(black_box(&geometry), &data).unwrap())
+            b.iter(|| {
+                EquilibriumSet::new(
+                    black_box(&geometry).jacobian().unwrap(),
+                    &data.t0,
+                    statics.cable_limits(),
+                    statics.joint_groups(),
+                )
+                .unwrap()
+            })
         });
         for policy in TensionPolicy::ALL {
             c.bench_function(&format!("policy {}, cdhrm5 {name}", policy.name()), |b| {

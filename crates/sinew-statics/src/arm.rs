@@ -1,17 +1,20 @@
-//! The arm's statics in one call: `T0`, then the tensions, for a robot and its routing (eq. 6,
-//! 22–23): at the paper's tension levels in closed form (three cables per universal joint), by
-//! a named policy over the equilibrium set of any cable set, or given and checked.
+//! The arm's statics for a robot and its routing (eq. 6, 22–23), in two stages: the pose
+//! stage ([`ArmStatics::set_pose`]: `T0`, `K_W`'s generators and `J_x` for a pose and a load),
+//! then any number of tension stages ([`ArmStatics::set_tensions`]): at the paper's tension
+//! levels in closed form (three cables per universal joint), by a named policy over the
+//! equilibrium set of any cable set (the set computed once per pose and kept), or given and
+//! checked.
 
 use std::ops::Range;
 
-use nalgebra::{Matrix3x2, Vector2, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
-use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_routing::{Routing, RoutingData};
 
 use crate::distribution::{CableLayout, distribute_tensions};
 use crate::equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, norm};
-use crate::error::{InfeasibleReason, StaticsError, UnsupportedRouting};
-use crate::interval::{TensionInterval, TensionLimits, minimum_norm_tensions};
+use crate::error::{LevelsInfeasible, NotBalanced, StaticsError, UnsupportedRouting};
+use crate::interval::{TensionInterval, TensionLimits};
 use crate::joint_end::{JointEndData, equilibrium_torques};
 use crate::policy::{Distribution, TensionPolicy, distribute_with_policy};
 
@@ -27,7 +30,42 @@ pub enum TensionChoice<'a> {
     /// These tensions (m, N, routing order), checked: within their limits and balancing the
     /// load to [`EQUILIBRIUM_TOLERANCE`].
     Given(&'a [f64]),
+    /// The default, the one every front end uses when the user chooses nothing: every joint at
+    /// tension level 0 where the closed form applies ([`ArmStatics::has_levels`]), else the
+    /// policy [`TensionPolicy::LeastTotal`]. Both are the least total tension of their kind.
+    Default,
 }
+
+/// How the tensions of the last tension stage were chosen ([`ArmStaticsData::chosen`]):
+/// [`TensionChoice`] with [`TensionChoice::Default`] resolved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Chosen {
+    /// No tension stage since the last pose stage.
+    Nothing,
+    /// The paper's tension levels (closed form).
+    Levels,
+    /// A named policy over the equilibrium set.
+    Policy(TensionPolicy),
+    /// Given tensions, checked.
+    Given,
+}
+
+impl Chosen {
+    /// The name the front ends print: `levels`, the policy's name, `given`, or `none`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Chosen::Nothing => "none",
+            Chosen::Levels => "levels",
+            Chosen::Policy(policy) => policy.name(),
+            Chosen::Given => "given",
+        }
+    }
+}
+
+/// Said where [`TensionChoice::Default`] fell back on the least-total policy because the
+/// routing does not take the tension levels.
+pub const DEFAULT_POLICY_NOTE: &str =
+    "tension levels need three cables per universal joint: the tensions are the policy least-total";
 
 /// What the statics of an arm needs from its routing, checked once.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +75,8 @@ pub struct ArmStatics {
     cable_limits: Vec<[f64; 2]>,
     cable_names: Vec<String>,
     groups: Vec<Range<usize>>,
+    /// Level 0 for every joint: [`TensionChoice::Default`] with the closed form.
+    lowest_levels: Vec<f64>,
 }
 
 /// Workspace and results of [`ArmStatics::solve`], sized once.
@@ -53,6 +93,13 @@ pub struct ArmStaticsData {
     /// The policy's answer of the last solve by a policy (`None` after levels or given
     /// tensions).
     pub distribution: Option<Distribution>,
+    /// The equilibrium set at the pose, once a policy or [`ArmStatics::equilibrium_set`] asked
+    /// for it (cleared by every pose stage).
+    set: Option<EquilibriumSet>,
+    /// How the tensions of the last tension stage were chosen.
+    chosen: Chosen,
+    /// Whether a pose stage has run (`T0`, the generators and `J_x` are those of a pose).
+    posed: bool,
 }
 
 impl ArmStaticsData {
@@ -60,6 +107,17 @@ impl ArmStaticsData {
     /// `T0` in one pass ([`equilibrium_torques`]).
     pub fn joint_end(&self) -> &JointEndData {
         &self.joint_end
+    }
+
+    /// How the tensions of the last tension stage were chosen ([`Chosen::Nothing`] before one).
+    pub fn chosen(&self) -> Chosen {
+        self.chosen
+    }
+
+    /// The equilibrium set of the current pose if it was already computed (by a policy or by
+    /// [`ArmStatics::equilibrium_set`]).
+    pub fn cached_equilibrium_set(&self) -> Option<&EquilibriumSet> {
+        self.set.as_ref()
     }
 }
 
@@ -74,6 +132,7 @@ impl ArmStatics {
             cable_limits: routing.cable_limits().to_vec(),
             cable_names: routing.cables().iter().map(|c| c.name.clone()).collect(),
             groups: routing.joint_groups().to_vec(),
+            lowest_levels: vec![0.0; routing.joint_count()],
         }
     }
 
@@ -133,16 +192,19 @@ impl ArmStatics {
             intervals: (0..n).map(|joint| TensionInterval { joint, ..empty }).collect(),
             tensions: vec![0.0; self.cable_count()],
             distribution: None,
+            set: None,
+            chosen: Chosen::Nothing,
+            posed: false,
         }
     }
 
     /// `T0`, the intervals and the tensions at `levels`, from kinematics and a cable Jacobian
     /// already computed for the same `Q` (`robot.forward_kinematics`, then
-    /// `compute_cable_geometry` with at least [`Order::Jacobian`]). No allocation.
+    /// `compute_cable_geometry` with at least [`sinew_routing::Order::Jacobian`]): the pose
+    /// stage, then one tension stage. No allocation.
     ///
     /// # Errors
-    /// [`StaticsError::Infeasible`] naming the first joint that fails,
-    /// [`StaticsError::LevelsUnavailable`], and the errors of the steps above.
+    /// As [`ArmStatics::set_pose`] and [`ArmStatics::set_tensions`].
     pub fn solve(
         &self,
         robot: &Robot,
@@ -155,14 +217,10 @@ impl ArmStatics {
         self.solve_with(robot, rdata, routing_data, data, f0, TensionChoice::Levels(levels))
     }
 
-    /// `T0` and the tensions chosen by `choice`, from kinematics and a cable Jacobian already
-    /// computed for the same `Q`. Levels: no allocation. A policy: the equilibrium set and a
-    /// small convex program (they allocate).
+    /// [`ArmStatics::set_pose`], then [`ArmStatics::set_tensions`] with `choice`.
     ///
     /// # Errors
-    /// Levels: as [`ArmStatics::solve`]. A policy: [`StaticsError::NoEquilibrium`] naming the
-    /// joints and the joint motion along which the cables fall short. Given tensions:
-    /// [`StaticsError::NotBalanced`]. And the errors of the steps above.
+    /// As those two.
     pub fn solve_with(
         &self,
         robot: &Robot,
@@ -172,93 +230,191 @@ impl ArmStatics {
         f0: &Vector6<f64>,
         choice: TensionChoice<'_>,
     ) -> Result<(), StaticsError> {
-        equilibrium_torques(robot, rdata, &mut data.joint_end, f0, &mut data.t0)?;
+        self.set_pose(robot, rdata, data, f0)?;
+        self.set_tensions(routing_data, data, choice)
+    }
+
+    /// The pose stage: `T0 = T_g + J_xᵀ F0`, `K_W`'s generators and `J_x` in one pass
+    /// ([`equilibrium_torques`]) from kinematics already computed for the pose. Forgets the
+    /// previous pose's equilibrium set and tensions' provenance. No allocation.
+    ///
+    /// # Errors
+    /// Those of [`equilibrium_torques`] (a non-finite wrench, a workspace of another robot).
+    pub fn set_pose(
+        &self,
+        robot: &Robot,
+        rdata: &mut RobotData,
+        data: &mut ArmStaticsData,
+        f0: &Vector6<f64>,
+    ) -> Result<(), StaticsError> {
+        data.posed = false;
+        data.set = None;
         data.distribution = None;
+        data.chosen = Chosen::Nothing;
+        equilibrium_torques(robot, rdata, &mut data.joint_end, f0, &mut data.t0)?;
+        data.posed = true;
+        Ok(())
+    }
+
+    /// A tension stage at the pose of the last [`ArmStatics::set_pose`] (whose cable Jacobian
+    /// is `routing_data`'s): the tensions chosen by `choice`. Levels: closed form, no
+    /// allocation. A policy: a small convex program over the equilibrium set, which is
+    /// computed at the first policy of a pose and kept (they allocate). Given: checked.
+    ///
+    /// # Errors
+    /// [`StaticsError::NoPose`] before a pose stage. Levels: [`StaticsError::Infeasible`]
+    /// naming the first joint that fails, or [`StaticsError::LevelsInfeasible`] when the
+    /// distal joints' levels overloaded it and tensions within the limits do balance the load
+    /// (a policy holds it); [`StaticsError::LevelsUnavailable`]; [`StaticsError::InvalidLevel`].
+    /// A policy: [`StaticsError::NoEquilibrium`] naming the joints and the joint motion along
+    /// which the cables fall short. Given tensions: [`StaticsError::NotBalanced`].
+    pub fn set_tensions(
+        &self,
+        routing_data: &RoutingData,
+        data: &mut ArmStaticsData,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StaticsError> {
+        if !data.posed {
+            return Err(StaticsError::NoPose);
+        }
+        data.distribution = None;
+        data.chosen = Chosen::Nothing;
+        let choice = match choice {
+            TensionChoice::Default if self.has_levels() => {
+                TensionChoice::Levels(&self.lowest_levels)
+            }
+            TensionChoice::Default => TensionChoice::Policy(TensionPolicy::LeastTotal),
+            choice => choice,
+        };
         match choice {
-            TensionChoice::Levels(levels) => distribute_tensions(
-                self.closed_form()?,
-                routing_data.jacobian()?,
-                self.limits,
-                &data.t0,
-                levels,
-                &mut data.intervals,
-                &mut data.tensions,
-            ),
+            TensionChoice::Levels(levels) => {
+                let solved = distribute_tensions(
+                    self.closed_form()?,
+                    routing_data.jacobian()?,
+                    self.limits,
+                    &data.t0,
+                    levels,
+                    &mut data.intervals,
+                    &mut data.tensions,
+                );
+                if let Err(e) = solved {
+                    return Err(self.levels_refusal(routing_data, data, e));
+                }
+                data.chosen = Chosen::Levels;
+                Ok(())
+            }
             TensionChoice::Policy(policy) => {
-                let set = self.equilibrium_set(routing_data, data)?;
+                self.cache_equilibrium_set(routing_data, data)?;
+                let Some(set) = data.set.as_ref() else {
+                    return Err(StaticsError::NoPose);
+                };
                 let answer = distribute_with_policy(
-                    &set,
+                    set,
                     policy,
                     &self.groups,
                     &self.cable_names,
                     &mut data.tensions,
                 )?;
                 data.distribution = Some(answer);
+                data.chosen = Chosen::Policy(policy);
                 Ok(())
             }
             TensionChoice::Given(tensions) => {
                 self.check_balance(routing_data, &data.t0, tensions)?;
                 data.tensions.copy_from_slice(tensions);
+                data.chosen = Chosen::Given;
                 Ok(())
             }
+            TensionChoice::Default => Err(StaticsError::NoPose),
         }
     }
 
-    /// The equilibrium set `f = f_p + N λ` at the last solved `Q` and load (its `T0` in
-    /// `data`), with every cable's limits.
-    ///
-    /// # Errors
-    /// As [`EquilibriumSet::new`].
-    pub fn equilibrium_set(
+    /// An infeasibility at levels, said as the levels' when they caused it: in the routed
+    /// model the distal joints' tensions are fixed first, and when they overload a proximal
+    /// joint while some tensions within the limits balance the load (a policy holds it), the
+    /// error names the distal joints and suggests a policy. Other errors pass unchanged.
+    fn levels_refusal(
         &self,
         routing_data: &RoutingData,
-        data: &ArmStaticsData,
-    ) -> Result<EquilibriumSet, StaticsError> {
-        EquilibriumSet::new(routing_data.jacobian()?, &data.t0, &self.cable_limits, &self.groups)
-    }
-
-    /// The paper's tension levels of balancing `tensions` (one per joint, in `[0, 1]`): where
-    /// each joint's own cables sit on its feasible interval, given the tensions of the cables
-    /// beyond it (routed), as [`ArmStatics::solve`] places them. Needs the closed form and a
-    /// solve at the same `Q` and load (its `T0` in `data`).
-    ///
-    /// # Errors
-    /// [`StaticsError::LevelsUnavailable`]; [`StaticsError::Infeasible`] for a joint whose
-    /// interval is empty; [`StaticsError::DimensionMismatch`].
-    pub fn levels_of(
-        &self,
-        routing_data: &RoutingData,
-        data: &ArmStaticsData,
-        tensions: &[f64],
-    ) -> Result<Vec<f64>, StaticsError> {
-        let layout = self.closed_form()?;
+        data: &mut ArmStaticsData,
+        error: StaticsError,
+    ) -> StaticsError {
+        let StaticsError::Infeasible { joint, torque, limits, reason } = error else {
+            return error;
+        };
+        let infeasible = StaticsError::Infeasible { joint, torque, limits, reason };
+        let Ok(layout) = self.closed_form() else { return infeasible };
+        let Ok(jacobian) = routing_data.jacobian() else { return infeasible };
         let n = layout.joints();
-        if tensions.len() != 3 * n {
-            let got = tensions.len();
-            return Err(StaticsError::DimensionMismatch { what: "tensions", expected: 3 * n, got });
+        if !layout.crossing() || joint + 1 >= n {
+            return infeasible;
         }
-        let jacobian = routing_data.jacobian()?;
-        let mut levels = vec![0.0; n];
-        for i in 0..n {
-            let mut tau = Vector2::new(data.t0[2 * i], data.t0[2 * i + 1]);
-            if layout.crossing() {
-                for c in 3 * (i + 1)..3 * n {
-                    tau[0] += jacobian[(c, 2 * i)] * tensions[c];
-                    tau[1] += jacobian[(c, 2 * i + 1)] * tensions[c];
+        // What each distal joint's cables add at the joint (the tensions its level fixed).
+        let distal: Vec<(usize, [f64; 2])> = (joint + 1..n)
+            .map(|j| {
+                let mut tau = [0.0; 2];
+                for c in 3 * j..3 * j + 3 {
+                    tau[0] += jacobian[(c, 2 * joint)] * data.tensions[c];
+                    tau[1] += jacobian[(c, 2 * joint + 1)] * data.tensions[c];
                 }
-            }
-            let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);
-            let interval = crate::interval::tension_interval(i, &block, &tau, self.limits)?;
-            let own = Vector3::new(tensions[3 * i], tensions[3 * i + 1], tensions[3 * i + 2]);
-            let lambda = interval.null.dot(&(own - interval.particular));
-            let width = interval.width();
-            levels[i] = if width > 0.0 {
-                ((lambda - interval.lambda_min) / width).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+                (j, tau)
+            })
+            .filter(|(_, tau)| tau[0] != 0.0 || tau[1] != 0.0)
+            .collect();
+        if distal.is_empty() || self.cache_equilibrium_set(routing_data, data).is_err() {
+            return infeasible;
         }
-        Ok(levels)
+        let Some(set) = data.set.as_ref() else { return infeasible };
+        let mut scratch = vec![0.0; self.cable_count()];
+        let policy = TensionPolicy::Safest;
+        if distribute_with_policy(set, policy, &self.groups, &self.cable_names, &mut scratch)
+            .is_err()
+        {
+            return infeasible;
+        }
+        StaticsError::LevelsInfeasible(Box::new(LevelsInfeasible {
+            joint,
+            torque,
+            limits,
+            reason,
+            distal,
+            policy,
+        }))
+    }
+
+    /// Compute the equilibrium set of the pose into `data` unless it is there.
+    fn cache_equilibrium_set(
+        &self,
+        routing_data: &RoutingData,
+        data: &mut ArmStaticsData,
+    ) -> Result<(), StaticsError> {
+        if !data.posed {
+            return Err(StaticsError::NoPose);
+        }
+        if data.set.is_none() {
+            data.set = Some(EquilibriumSet::new(
+                routing_data.jacobian()?,
+                &data.t0,
+                &self.cable_limits,
+                &self.groups,
+            )?);
+        }
+        Ok(())
+    }
+
+    /// The equilibrium set `f = f_p + N λ` at the last pose (its `T0` in `data`), with every
+    /// cable's limits: computed at its first use after the pose stage (an SVD of `J_c`,
+    /// which allocates), then kept in `data` for every later tension stage of the pose.
+    ///
+    /// # Errors
+    /// [`StaticsError::NoPose`]; as [`EquilibriumSet::new`].
+    pub fn equilibrium_set<'d>(
+        &self,
+        routing_data: &RoutingData,
+        data: &'d mut ArmStaticsData,
+    ) -> Result<&'d EquilibriumSet, StaticsError> {
+        self.cache_equilibrium_set(routing_data, data)?;
+        data.set.as_ref().ok_or(StaticsError::NoPose)
     }
 
     /// Check that `tensions` are within their limits and balance `t0`.
@@ -278,14 +434,11 @@ impl ArmStatics {
         }
         for (c, (&f, [lo, hi])) in tensions.iter().zip(&self.cable_limits).enumerate() {
             if !(f.is_finite() && *lo <= f && f <= *hi) {
-                let problem = format!(
-                    "leave the limits: cable `{}` has {} N, outside [{}, {}] N",
-                    self.cable_names[c],
-                    sinew_robot::Compact(f),
-                    sinew_robot::Compact(*lo),
-                    sinew_robot::Compact(*hi)
-                );
-                return Err(StaticsError::NotBalanced { problem });
+                return Err(StaticsError::NotBalanced(NotBalanced::OutsideLimits {
+                    cable: self.cable_names[c].clone(),
+                    tension: f,
+                    limits: [*lo, *hi],
+                }));
             }
         }
         let jacobian = routing_data.jacobian()?;
@@ -298,88 +451,11 @@ impl ArmStatics {
                 .fold(0.0, f64::max),
         );
         if norm(&residual) > EQUILIBRIUM_TOLERANCE * scale {
-            let problem = format!(
-                "do not balance the load: |T0 + J_cᵀ f| = {} N m, |T0| = {} N m",
-                sinew_robot::Compact(norm(&residual)),
-                sinew_robot::Compact(norm(t0))
-            );
-            return Err(StaticsError::NotBalanced { problem });
+            return Err(StaticsError::NotBalanced(NotBalanced::Residual {
+                residual: norm(&residual),
+                t0: norm(t0),
+            }));
         }
         Ok(())
-    }
-
-    /// `∂f/∂λ_i`: how every tension changes per unit of joint `i`'s null-space coordinate,
-    /// the other joints' `λ` held, balance kept (3n, into `out`). Decoupled: joint `i`'s null
-    /// direction on its own cables, zero elsewhere. Routed: the distal change loads the
-    /// proximal joints, whose minimum-norm tensions follow, from joint `i − 1` down to the
-    /// base. The map `λ → f` is affine, so this is exact. Needs a [`ArmStatics::solve`] at
-    /// the same `Q` first. No allocation.
-    ///
-    /// # Errors
-    /// [`StaticsError::LevelsUnavailable`], [`StaticsError::NoSuchJoint`],
-    /// [`StaticsError::DimensionMismatch`]; [`StaticsError::Infeasible`] for a rank-deficient
-    /// proximal joint.
-    pub fn tension_sensitivity(
-        &self,
-        routing_data: &RoutingData,
-        data: &ArmStaticsData,
-        joint: usize,
-        out: &mut [f64],
-    ) -> Result<(), StaticsError> {
-        let layout = self.closed_form()?;
-        let n = layout.joints();
-        if joint >= n {
-            return Err(StaticsError::NoSuchJoint { joint, joints: n });
-        }
-        if out.len() != 3 * n {
-            return Err(StaticsError::DimensionMismatch {
-                what: "tension sensitivity",
-                expected: 3 * n,
-                got: out.len(),
-            });
-        }
-        out.fill(0.0);
-        out[3 * joint..3 * joint + 3].copy_from_slice(data.intervals[joint].null.as_slice());
-        if !layout.crossing() {
-            return Ok(());
-        }
-        let jacobian = routing_data.jacobian()?;
-        for k in (0..joint).rev() {
-            let mut delta_tau = Vector2::zeros();
-            for c in 3 * (k + 1)..3 * n {
-                delta_tau[0] += jacobian[(c, 2 * k)] * out[c];
-                delta_tau[1] += jacobian[(c, 2 * k + 1)] * out[c];
-            }
-            let block = Matrix3x2::from_fn(|r, col| jacobian[(3 * k + r, 2 * k + col)]);
-            let delta = minimum_norm_tensions(&block, &delta_tau).ok_or_else(|| {
-                StaticsError::Infeasible {
-                    joint: k,
-                    torque: [data.t0[2 * k], data.t0[2 * k + 1]],
-                    limits: [self.limits.f_min, self.limits.f_max],
-                    reason: InfeasibleReason::RankDeficient,
-                }
-            })?;
-            out[3 * k..3 * k + 3].copy_from_slice(delta.as_slice());
-        }
-        Ok(())
-    }
-
-    /// [`ArmStatics::solve`] at `Q`: forward kinematics and the cable Jacobian first.
-    ///
-    /// # Errors
-    /// As [`ArmStatics::solve`], plus robot and routing errors for `Q`.
-    pub fn solve_at(
-        &self,
-        robot: &Robot,
-        routing: &Routing,
-        rdata: &mut RobotData,
-        routing_data: &mut RoutingData,
-        data: &mut ArmStaticsData,
-        q: &[f64],
-        f0: &Vector6<f64>,
-        levels: &[f64],
-    ) -> Result<(), StaticsError> {
-        compute_cable_geometry(routing, robot, rdata, routing_data, q, Order::Jacobian)?;
-        self.solve(robot, rdata, routing_data, data, f0, levels)
     }
 }

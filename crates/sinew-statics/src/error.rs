@@ -221,11 +221,17 @@ pub enum StaticsError {
     )]
     LevelsUnavailable(UnsupportedRouting),
     /// Given tensions that do not balance the load or leave their limits.
-    #[error("the given tensions {problem}")]
-    NotBalanced {
-        /// What is wrong, with the numbers.
-        problem: String,
-    },
+    #[error("the given tensions {0}")]
+    NotBalanced(NotBalanced),
+    /// A tension stage asked of a workspace that has had no pose stage
+    /// ([`crate::ArmStatics::set_pose`]).
+    #[error("no pose: set the pose and the load before choosing tensions")]
+    NoPose,
+    /// The tension levels could not be met, because the distal joints' levels (whose tensions
+    /// the routed closed form fixes first) overloaded a proximal joint, while tensions within
+    /// the limits do balance the load (a policy holds it).
+    #[error("{0}")]
+    LevelsInfeasible(Box<LevelsInfeasible>),
     /// A NaN or infinite entry in a computed input (the cable Jacobian, `T0`).
     #[error("{what} has a NaN or infinite entry")]
     NonFiniteInput {
@@ -328,5 +334,95 @@ impl std::fmt::Display for NoEquilibrium {
                 write!(f, " (raise those limits or lighten the load)")
             }
         }
+    }
+}
+
+/// What is wrong with given tensions ([`StaticsError::NotBalanced`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum NotBalanced {
+    /// A tension outside its cable's limits (or not finite).
+    OutsideLimits {
+        /// The cable's name.
+        cable: String,
+        /// Its tension, N.
+        tension: f64,
+        /// Its `[f_min, f_max]`, N.
+        limits: [f64; 2],
+    },
+    /// The tensions leave a torque unbalanced: `|T0 + J_cᵀ f|` above
+    /// [`crate::EQUILIBRIUM_TOLERANCE`] of the torques' scale.
+    Residual {
+        /// `|T0 + J_cᵀ f|`, N m.
+        residual: f64,
+        /// `|T0|`, N m.
+        t0: f64,
+    },
+}
+
+impl std::fmt::Display for NotBalanced {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NotBalanced::OutsideLimits { cable, tension, limits } => write!(
+                f,
+                "leave the limits: cable `{cable}` has {} N, outside [{}, {}] N",
+                Compact(*tension),
+                Compact(limits[0]),
+                Compact(limits[1])
+            ),
+            NotBalanced::Residual { residual, t0 } => write!(
+                f,
+                "do not balance the load: |T0 + J_cᵀ f| = {} N m, |T0| = {} N m",
+                Compact(*residual),
+                Compact(*t0)
+            ),
+        }
+    }
+}
+
+/// A refusal of the tension levels that the levels caused ([`StaticsError::LevelsInfeasible`]):
+/// in the routed model the closed form fixes the distal joints' tensions first, at their levels,
+/// and those tensions load the proximal joints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevelsInfeasible {
+    /// The joint that cannot hold its torque (0-based; the message counts from 1).
+    pub joint: usize,
+    /// The torque its own cables must hold, N m (the load's and the distal cables').
+    pub torque: [f64; 2],
+    /// `[f_min, f_max]`, N.
+    pub limits: [f64; 2],
+    /// Why its own cables cannot hold it.
+    pub reason: InfeasibleReason,
+    /// The distal joints whose levels did it (0-based), each with the torque its cables add
+    /// at `joint`, N m.
+    pub distal: Vec<(usize, [f64; 2])>,
+    /// A policy that holds the same load within the limits.
+    pub policy: crate::TensionPolicy,
+}
+
+impl std::fmt::Display for LevelsInfeasible {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let joints: Vec<String> = self.distal.iter().map(|(j, _)| (j + 1).to_string()).collect();
+        let added = self.distal.iter().fold([0.0; 2], |a, (_, t)| [a[0] + t[0], a[1] + t[1]]);
+        write!(
+            f,
+            "joint {} cannot hold torque [{}, {}] N m with tensions in [{}, {}] N at these tension levels: {}; \
+             the levels of joint{} {} fixed their cables' tensions first, and those add [{}, {}] N m at joint {}. \
+             Tensions within the limits do balance this load: choose a tension policy instead of levels \
+             (e.g. {}: `--policy {}` on the command line, `policy=\"{}\"` in Python)",
+            self.joint + 1,
+            Compact(self.torque[0]),
+            Compact(self.torque[1]),
+            Compact(self.limits[0]),
+            Compact(self.limits[1]),
+            self.reason,
+            if joints.len() == 1 { "" } else { "s" },
+            joints.join(", "),
+            Compact(added[0]),
+            Compact(added[1]),
+            self.joint + 1,
+            self.policy.name(),
+            self.policy.name(),
+            self.policy.name(),
+        )
     }
 }

@@ -25,13 +25,15 @@ mod equilibrium;
 mod error;
 mod interval;
 mod joint_end;
+mod levels;
 mod policy;
 
-pub use arm::{ArmStatics, ArmStaticsData, TensionChoice};
+pub use arm::{ArmStatics, ArmStaticsData, Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, SET_RANK_TOLERANCE};
 pub use error::{
-    InfeasibleReason, NoEquilibrium, NoEquilibriumCause, StaticsError, UnsupportedRouting,
+    InfeasibleReason, LevelsInfeasible, NoEquilibrium, NoEquilibriumCause, NotBalanced,
+    StaticsError, UnsupportedRouting,
 };
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,

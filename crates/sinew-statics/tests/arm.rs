@@ -40,7 +40,9 @@ fn every_level_balances_t0_at_random_configurations_and_loads() {
                     .solve_at(&robot, &routing, &mut rdata, &mut gdata, &mut data, &q, &f0, &levels)
                 {
                     Ok(()) => {}
-                    Err(StaticsError::Infeasible { .. }) => continue,
+                    Err(StaticsError::Infeasible { .. } | StaticsError::LevelsInfeasible(_)) => {
+                        continue;
+                    }
                     Err(e) => panic!("{name}: {e}"),
                 }
                 solved += 1;

@@ -13,6 +13,7 @@ use faer::Mat;
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver, joint_stiffness};
 use sinew_testkit::cdhrm5;
 
@@ -62,11 +63,17 @@ fn bench_pipeline(c: &mut Criterion) {
         let model = ArmStiffness::new(&cdhrm5, &routing).unwrap();
         let mut data = ArmStiffnessData::new(&model);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        model.evaluate(&mut data, &pose, &f0, &[0.5; 5]).unwrap();
+        model.evaluate(&mut data, &pose, &f0, TensionChoice::Levels(&[0.5; 5])).unwrap();
         group.bench_with_input(
             BenchmarkId::new(format!("cdhrm5 loaded {label}"), 10),
             &pose,
-            |b, q| b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &[0.5; 5]).unwrap()),
+            |b, q| {
+                b.iter(|| {
+                    model
+                        .evaluate(&mut data, black_box(q), &f0, TensionChoice::Levels(&[0.5; 5]))
+                        .unwrap()
+                })
+            },
         );
     }
     for joints in [25, 50, 100] {
@@ -77,10 +84,14 @@ fn bench_pipeline(c: &mut Criterion) {
             let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
             let levels = vec![0.1; joints];
             let f0 = Vector6::zeros();
-            model.evaluate(&mut data, &q, &f0, &levels).unwrap();
+            model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
             let label = format!("uniform {model_kind:?}").to_lowercase();
             group.bench_with_input(BenchmarkId::new(label, 2 * joints), &q, |b, q| {
-                b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
+                b.iter(|| {
+                    model
+                        .evaluate(&mut data, black_box(q), &f0, TensionChoice::Levels(&levels))
+                        .unwrap()
+                })
             });
         }
     }
@@ -94,10 +105,14 @@ fn bench_pipeline(c: &mut Criterion) {
         let q: Vec<f64> = (0..200).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
         let levels = vec![0.1; 100];
         let f0 = Vector6::new(0.0, 0.005, 0.0, 0.0, 0.0, 0.0005);
-        model.evaluate(&mut data, &q, &f0, &levels).unwrap();
+        model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
         assert_eq!(data.end_solver(), EndSolver::Structured);
         group.bench_with_input(BenchmarkId::new("uniform decoupled loaded", 200), &q, |b, q| {
-            b.iter(|| model.evaluate(&mut data, black_box(q), &f0, &levels).unwrap())
+            b.iter(|| {
+                model
+                    .evaluate(&mut data, black_box(q), &f0, TensionChoice::Levels(&levels))
+                    .unwrap()
+            })
         });
     }
     group.finish();

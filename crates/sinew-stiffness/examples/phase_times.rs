@@ -96,9 +96,16 @@ fn main() {
         let model = ArmStiffness::new(&robot, &routing).unwrap();
         let mut data = ArmStiffnessData::new(&model);
         let levels = vec![0.1; joints];
-        model.evaluate(&mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        model.evaluate(&mut data, &q, &Vector6::zeros(), TensionChoice::Levels(&levels)).unwrap();
         let joint = best(reps, || {
-            model.joint_level(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
+            model
+                .evaluate_joints(
+                    &mut data,
+                    black_box(&q),
+                    &Vector6::zeros(),
+                    TensionChoice::Levels(&levels),
+                )
+                .unwrap();
         });
         let statics = best(reps, || {
             let ArmStiffnessData { robot: r, cables, statics, .. } = &mut data;
@@ -134,7 +141,14 @@ fn main() {
             black_box(r.is_ok());
         });
         let pipe = best(reps, || {
-            model.evaluate(&mut data, black_box(&q), &Vector6::zeros(), &levels).unwrap();
+            model
+                .evaluate(
+                    &mut data,
+                    black_box(&q),
+                    &Vector6::zeros(),
+                    TensionChoice::Levels(&levels),
+                )
+                .unwrap();
         });
         let us = |t: f64| format!("{:.2} µs", t * 1e6);
         println!(
@@ -156,9 +170,11 @@ fn main() {
         let routing = cdhrm5::routing(&robot, kind);
         let model = ArmStiffness::new(&robot, &routing).unwrap();
         let mut data = ArmStiffnessData::new(&model);
-        model.evaluate(&mut data, &pose, &f0, &[0.5; 5]).unwrap();
+        model.evaluate(&mut data, &pose, &f0, TensionChoice::Levels(&[0.5; 5])).unwrap();
         let pipe = best(20_000, || {
-            model.evaluate(&mut data, black_box(&pose), &f0, &[0.5; 5]).unwrap();
+            model
+                .evaluate(&mut data, black_box(&pose), &f0, TensionChoice::Levels(&[0.5; 5]))
+                .unwrap();
         });
         println!("cdhrm5 loaded, {kind:?}: pipeline {:.2} µs", pipe * 1e6);
     }

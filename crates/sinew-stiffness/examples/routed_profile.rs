@@ -10,6 +10,7 @@ use std::hint::black_box;
 
 use nalgebra::{Vector3, Vector6};
 use sinew_routing::PatternModel;
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
 
@@ -29,9 +30,9 @@ fn main() {
     let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
     let levels = vec![0.1; joints];
     let f0 = Vector6::zeros();
-    model.evaluate(&mut data, &q, &f0, &levels).unwrap();
+    model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
     for _ in 0..evals {
-        model.evaluate(&mut data, black_box(&q), &f0, &levels).unwrap();
+        model.evaluate(&mut data, black_box(&q), &f0, TensionChoice::Levels(&levels)).unwrap();
     }
     println!("{:?} {} DOF: K_x[0,0] = {:e}", model_kind, 2 * joints, data.stiffness()[(0, 0)]);
 }

@@ -12,6 +12,7 @@ use std::time::Instant;
 use nalgebra::Vector6;
 use rayon::prelude::*;
 use sinew_routing::PatternModel;
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
 
@@ -27,7 +28,9 @@ fn run(arm: &ArmStiffness, q: &[f64], f0: &Vector6<f64>, levels: &[f64]) -> (f64
         .map_init(
             || ArmStiffnessData::new(arm),
             |data, rows| {
-                rows.chunks_exact(dof).filter(|q| arm.evaluate(data, q, f0, levels).is_ok()).count()
+                rows.chunks_exact(dof)
+                    .filter(|q| arm.evaluate(data, q, f0, TensionChoice::Levels(levels)).is_ok())
+                    .count()
             },
         )
         .sum();

@@ -1,5 +1,7 @@
-//! [`ArmStiffnessData`]: the workspace of [`crate::ArmStiffness`], sized from it once, and the
-//! results of its last evaluation.
+//! [`ArmStiffnessData`]: the workspace of [`crate::ArmStiffness`], sized from it once
+//! ([`ArmStiffnessData::new`]), and the results of its stages: the pose stage (geometry,
+//! `T0`, `K_W`'s generators, `J_x`, the equilibrium set on demand), the tension stage
+//! (tensions, `K_q`) and the end stage (`C_x`, `K_x`, the [`EndOutcome`]).
 
 use faer::MatRef;
 use nalgebra::{Matrix2, Matrix3};
@@ -7,16 +9,99 @@ use sinew_robot::RobotData;
 use sinew_routing::RoutingData;
 use sinew_statics::{ArmStaticsData, TensionInterval};
 
-use crate::arm::{ArmStiffness, EndSolver};
 use crate::colmajor::ColMajor;
-use crate::end::{EndStiffnessData, stability_margin};
+use crate::end::stability_margin;
+use crate::end_data::EndStiffnessData;
 use crate::error::StiffnessError;
-use crate::joint::{InherentScratch, joint_block};
+use crate::inherent::InherentScratch;
+use crate::joint::joint_block;
 use crate::structured::{BlockLayout, StructuredData};
 
-/// Every workspace and result of the pipeline, sized once from an [`ArmStiffness`] (no
+/// Which solver computed the end compliance of the last evaluation
+/// ([`ArmStiffnessData::end_solver`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum EndSolver {
+    /// No end compliance yet (no evaluation, or the last one stopped before `C_x`).
+    NotYet,
+    /// The structured `O(dof)` solve: `K_q` block diagonal (decoupled model), `K_W`
+    /// semiseparable, the result checked by its residual.
+    Structured,
+    /// The dense reference [`crate::end_compliance`]: Cholesky of the symmetric part of
+    /// `K_q + K_W`, then a Cholesky or LU solve (`O(dof³)`).
+    Dense,
+}
+
+/// What the end stage found (eq. 19, spec §5): the typed outcome of an evaluation. Unstable
+/// and rank-deficient are answers, not failures: [`EndOutcome::into_result`] turns them into
+/// [`StiffnessError::Unstable`] and [`StiffnessError::RankDeficient`] for callers that need
+/// `K_x`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EndOutcome {
+    /// `K_q + K_W` positive definite and `J_x` of full rank ([`crate::has_full_rank`]):
+    /// `C_x`, `K_x` and `K_fd` exist.
+    Stiff,
+    /// Stable, but `J_x` has rank < 6: `C_x` exists, `K_x` and `K_fd` do not.
+    RankDeficient {
+        /// Smallest over largest pivot magnitude of `C_x`'s LU factorisation.
+        pivot_ratio: f64,
+    },
+    /// `K_q + K_W` is not positive definite: the equilibrium is unstable, no `C_x` exists.
+    Unstable {
+        /// The smallest eigenvalue of the symmetric part of `K_q + K_W`, N m/rad.
+        min_eigenvalue: f64,
+    },
+}
+
+impl EndOutcome {
+    /// Whether `K_q + K_W` is positive definite (`C_x` exists).
+    pub fn is_stable(self) -> bool {
+        !matches!(self, EndOutcome::Unstable { .. })
+    }
+
+    /// Whether `K_x` exists: stable and `J_x` of full rank.
+    pub fn has_end_stiffness(self) -> bool {
+        matches!(self, EndOutcome::Stiff)
+    }
+
+    /// `Ok(())` when `K_x` exists, else the error that says why not.
+    ///
+    /// # Errors
+    /// [`StiffnessError::Unstable`], [`StiffnessError::RankDeficient`].
+    pub fn into_result(self) -> Result<(), StiffnessError> {
+        match self {
+            EndOutcome::Stiff => Ok(()),
+            EndOutcome::RankDeficient { pivot_ratio } => {
+                Err(StiffnessError::RankDeficient { pivot_ratio })
+            }
+            EndOutcome::Unstable { min_eigenvalue } => {
+                Err(StiffnessError::Unstable { min_eigenvalue })
+            }
+        }
+    }
+}
+
+/// How far the workspace's stages have come since the last pose stage.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Stage {
+    /// No pose (new workspace, or the last pose stage failed).
+    Empty,
+    /// Geometry, `T0`, `K_W`'s generators and `J_x` of a pose.
+    Posed,
+    /// And tensions and `K_q`.
+    Tensioned,
+    /// And the end stage's outcome.
+    Ended(EndOutcome),
+}
+
+/// Every workspace and result of the pipeline, sized once from a [`crate::ArmStiffness`] (no
 /// allocation per configuration). A plain workspace: which arm it belongs to is checked by
-/// [`ArmStiffness::check`] at every evaluation.
+/// [`crate::ArmStiffness::check`] at every stage.
+///
+/// Who writes what: the pose stage writes `robot`, `cables` and the pose part of `statics`
+/// (`T0`, `J_x`, `K_W`'s generators) and clears the rest; the tension stage writes the
+/// tensions (`statics`), `K_c`, `K_i` and `K_q`; the end stage writes `C_x`, `K_x` and the
+/// outcome. Nothing else writes them.
 #[derive(Debug)]
 pub struct ArmStiffnessData {
     /// Kinematics workspace.
@@ -26,7 +111,7 @@ pub struct ArmStiffnessData {
     /// `T0`, `K_W`'s generators, `J_x`, intervals, tensions.
     pub statics: ArmStaticsData,
     /// The layout of the arm the workspace was made for (its check).
-    layout: BlockLayout,
+    pub(crate) layout: BlockLayout,
     pub(crate) structured: StructuredData,
     pub(crate) solver: EndSolver,
     pub(crate) k_controllable: ColMajor,
@@ -39,30 +124,16 @@ pub struct ArmStiffnessData {
     pub(crate) k_w_filled: ColMajor,
     pub(crate) end: EndStiffnessData,
     pub(crate) sensitivity: Vec<f64>,
+    /// How far the stages have come.
+    pub(crate) stage: Stage,
+    /// Whether `k_inherent` is that of the current pose (the routed model computes it at the
+    /// first tension stage of a pose and keeps it: it does not depend on the tensions).
+    pub(crate) inherent_current: bool,
+    /// How many pose stages this workspace has run ([`ArmStiffnessData::pose_stages`]).
+    pub(crate) pose_stages: u64,
 }
 
 impl ArmStiffnessData {
-    /// A workspace for `arm`.
-    pub fn new(arm: &ArmStiffness) -> ArmStiffnessData {
-        let n = arm.dof();
-        let layout = arm.layout().clone();
-        ArmStiffnessData {
-            robot: RobotData::new(arm.robot()),
-            cables: RoutingData::new(arm.routing()),
-            statics: arm.statics().data(arm.robot()),
-            structured: StructuredData::new(&layout),
-            layout,
-            solver: EndSolver::NotYet,
-            k_controllable: ColMajor::zeros(n, n),
-            k_inherent: ColMajor::zeros(n, n),
-            inherent: arm.inherent_plan().scratch(),
-            k_q: ColMajor::zeros(n, n),
-            k_w_filled: ColMajor::zeros(n, n),
-            end: EndStiffnessData::new(n),
-            sensitivity: vec![0.0; arm.routing().cable_count()],
-        }
-    }
-
     pub(crate) fn layout(&self) -> &BlockLayout {
         &self.layout
     }
@@ -148,6 +219,21 @@ impl ArmStiffnessData {
     /// The tensions (N), cables in routing order.
     pub fn tensions(&self) -> &[f64] {
         &self.statics.tensions
+    }
+
+    /// The outcome of the last end stage, `None` when the stages since the last pose have not
+    /// reached it ([`crate::ArmStiffness::solve_end`]).
+    pub fn end_outcome(&self) -> Option<EndOutcome> {
+        match self.stage {
+            Stage::Ended(outcome) => Some(outcome),
+            _ => None,
+        }
+    }
+
+    /// How many pose stages this workspace has run since it was made: what a caller that
+    /// should pose once (the planner) is tested by.
+    pub fn pose_stages(&self) -> u64 {
+        self.pose_stages
     }
 
     /// Which solver computed the last end compliance.

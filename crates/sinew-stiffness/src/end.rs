@@ -19,167 +19,18 @@
 //! the Cholesky factor already computed for the verdict, else with a partially pivoted LU.
 //! `K_x = C_x⁻¹` comes from a 6 × 6 LU with partial pivoting on the stack (the kernel the
 //! structured solve uses for its pivot blocks), whose pivots also decide whether `J_x` has
-//! full rank ([`RANK_TOLERANCE`]).
+//! full rank ([`crate::END_RANK_TOLERANCE`]).
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::dyn_stack::MemStack;
 use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting as lu;
 use faer::{Mat, MatRef, Par, Side};
-use nalgebra::Matrix3;
 use sinew_statics::KwGenerators;
 
 use crate::cholesky;
 use crate::colmajor::ColMajor;
+use crate::end_data::EndStiffnessData;
 use crate::error::StiffnessError;
-
-/// Relative size below which a pivot of `C_x`'s factorisation counts as zero: the end-effector
-/// Jacobian has rank < 6 and `K_x` does not exist.
-pub const RANK_TOLERANCE: f64 = 1e-10;
-
-/// Workspace of the end stiffness, sized once for `dof` joints: the factorisations run in place
-/// in it, so evaluating a configuration allocates nothing.
-pub struct EndStiffnessData {
-    dof: usize,
-    /// `K_q + K_W`, then its LU factors when it is not symmetric.
-    a: ColMajor,
-    /// Symmetric part of `K_q + K_W`, then its Cholesky factor.
-    sym: ColMajor,
-    /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6), the non-symmetric case.
-    x: Mat<f64>,
-    /// `L⁻¹ J_xᵀ`, row-major dof × 6, the symmetric case.
-    y: Vec<f64>,
-    /// `C_x`, column-major 6 × 6.
-    c_x: [f64; 36],
-    /// `K_x`, column-major 6 × 6.
-    k_x: [f64; 36],
-    perm: Vec<usize>,
-    perm_inv: Vec<usize>,
-    buffer: MemBuffer,
-}
-
-impl EndStiffnessData {
-    /// A workspace for `dof` joints.
-    pub fn new(dof: usize) -> EndStiffnessData {
-        let req = StackReq::any_of(&[
-            llt::factor::cholesky_in_place_scratch::<f64>(dof, Par::Seq, Default::default()),
-            lu::factor::lu_in_place_scratch::<usize, f64>(dof, dof, Par::Seq, Default::default()),
-            lu::solve::solve_in_place_scratch::<usize, f64>(dof, 6, Par::Seq),
-        ]);
-        EndStiffnessData {
-            dof,
-            a: ColMajor::zeros(dof, dof),
-            sym: ColMajor::zeros(dof, dof),
-            x: Mat::zeros(dof, 6),
-            y: vec![0.0; 6 * dof],
-            c_x: [0.0; 36],
-            k_x: [0.0; 36],
-            perm: vec![0; dof],
-            perm_inv: vec![0; dof],
-            buffer: MemBuffer::new(req),
-        }
-    }
-
-    /// `C_x` (6 × 6, m/N, rad/(N m)) from the last [`end_compliance`].
-    pub fn compliance(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.c_x, 6, 6)
-    }
-
-    /// `K_x` (6 × 6) from the last [`end_stiffness`].
-    pub fn stiffness(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.k_x, 6, 6)
-    }
-
-    /// `K_fd = K_x[0:3, 0:3]` (N/m), the paper's translational stiffness (eq. 21): the force
-    /// per unit displacement when the end-effector's rotation is held.
-    pub fn k_fd(&self) -> Matrix3<f64> {
-        Matrix3::from_fn(|i, j| self.k_x[i + 6 * j])
-    }
-
-    /// `(C_x[0:3, 0:3])⁻¹` (N/m): the force per unit displacement when the end-effector is
-    /// free to rotate (a pure force applied). `None` when that block is singular: its smallest
-    /// singular value at most [`RANK_TOLERANCE`] of its largest (the end cannot translate in
-    /// some direction, and a plain inverse would return numbers of 1e17), or not finite.
-    pub fn translational_stiffness(&self) -> Option<Matrix3<f64>> {
-        let block = Matrix3::from_fn(|i, j| self.c_x[i + 6 * j]);
-        let sv = block.singular_values();
-        // Written so that NaN also counts as singular.
-        if sv.min() > RANK_TOLERANCE * sv.max() { block.try_inverse() } else { None }
-    }
-
-    /// Store a compliance computed elsewhere (the structured solve), row-major.
-    pub(crate) fn set_compliance(&mut self, c_x: &[[f64; 6]; 6]) {
-        for (i, row) in c_x.iter().enumerate() {
-            for (j, v) in row.iter().enumerate() {
-                self.c_x[i + 6 * j] = *v;
-            }
-        }
-    }
-
-    /// `K_x = C_x⁻¹` (eq. 19) from the stored `C_x`: LU with partial pivoting (6 × 6, on the
-    /// stack), the rank test on its pivots, then the inverse from the factors (`K_x` written
-    /// only when the test passes).
-    ///
-    /// # Errors
-    /// [`StiffnessError::RankDeficient`] when a pivot is below [`RANK_TOLERANCE`] of the
-    /// largest (NaN pivots included).
-    pub(crate) fn invert_compliance(&mut self) -> Result<(), StiffnessError> {
-        const IDENTITY: [[f64; 6]; 6] = [
-            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-            [0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
-        ];
-        // Rows of C_x, factorised in place: P C_x = L U (the structured solve's block LU),
-        // the reciprocals of U's pivots on the diagonal.
-        let mut lu = [[0.0; 6]; 6];
-        for (j, col) in self.c_x.chunks_exact(6).enumerate() {
-            for (i, v) in col.iter().enumerate() {
-                lu[i][j] = *v;
-            }
-        }
-        let mut perm = [0; 6];
-        let factored = crate::structured::lu(&mut lu, &mut perm);
-        let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
-        if factored {
-            for (r, row) in lu.iter().enumerate() {
-                let pivot = 1.0 / row[r];
-                (lo, hi) = (lo.min(pivot.abs()), hi.max(pivot.abs()));
-            }
-        } else {
-            // A zero or non-finite pivot.
-            lo = 0.0;
-            hi = self.c_x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        }
-        // Written so that NaN pivots also count as rank-deficient.
-        let full_rank = factored && lo > RANK_TOLERANCE * hi;
-        if !full_rank {
-            return Err(StiffnessError::RankDeficient {
-                pivot_ratio: if hi > 0.0 { lo / hi } else { 0.0 },
-            });
-        }
-        // K_x = U⁻¹ L⁻¹ P, all six columns at once (x[r] is row r of the solution).
-        let mut x = IDENTITY;
-        crate::structured::lu_solve(&lu, &perm, &mut x);
-        for (c, col) in self.k_x.chunks_exact_mut(6).enumerate() {
-            for (r, out) in col.iter_mut().enumerate() {
-                *out = x[r][c];
-            }
-        }
-        Ok(())
-    }
-}
-
-impl std::fmt::Debug for EndStiffnessData {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("EndStiffnessData")
-            .field("dof", &self.dof)
-            .field("c_x", &self.compliance())
-            .field("k_x", &self.stiffness())
-            .finish_non_exhaustive()
-    }
-}
 
 fn check_square(what: &'static str, m: MatRef<'_, f64>, n: usize) -> Result<(), StiffnessError> {
     for got in [m.nrows(), m.ncols()] {
@@ -457,7 +308,7 @@ fn gram_of_forward_substitution(l: &ColMajor, y: &mut [f64], c_x: &mut [f64; 36]
 ///
 /// # Errors
 /// Those of [`end_compliance`], and [`StiffnessError::RankDeficient`] when `J_x` has rank < 6
-/// (a pivot of `C_x` below [`RANK_TOLERANCE`] of the largest): `C_x` is then still in `data`.
+/// (a pivot of `C_x` below [`crate::END_RANK_TOLERANCE`] of the largest): `C_x` is then still in `data`.
 pub fn end_stiffness(
     k_q: MatRef<'_, f64>,
     k_w: MatRef<'_, f64>,

@@ -35,6 +35,25 @@ pub enum StiffnessError {
         /// Which matrix.
         what: &'static str,
     },
+    /// A zero or non-finite direction for a directional stiffness.
+    #[error(
+        "direction [{}, {}, {}] is not a non-zero finite vector",
+        Compact(.direction[0]), Compact(.direction[1]), Compact(.direction[2])
+    )]
+    InvalidDirection {
+        /// The direction passed.
+        direction: [f64; 3],
+    },
+    /// A stage of the pipeline asked for before the stage it needs: tensions before a pose
+    /// ([`crate::ArmStiffness::set_pose`]), the end before tensions
+    /// ([`crate::ArmStiffness::set_tensions`]).
+    #[error("{needs} first: the workspace has no {missing} yet")]
+    StageMissing {
+        /// The call that must come first.
+        needs: &'static str,
+        /// What the workspace lacks.
+        missing: &'static str,
+    },
     /// The eigen-decomposition did not converge.
     #[error("the eigen-decomposition of K_q + K_W did not converge")]
     Eigen,

@@ -1,5 +1,5 @@
 //! The whole pipeline `Q → K_x` allocates nothing once the workspace exists: decoupled (the
-//! structured solve) and routed (the dense reference), `evaluate` and `evaluate_compliance`,
+//! structured solve) and routed (the dense reference), `evaluate` and the stages one by one (a pose, two tension stages, the end),
 //! and the dense `K_W` materialised on request.
 //!
 //! A counting global allocator (this test binary only) counts every allocation made while the
@@ -9,6 +9,7 @@
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::Robot;
 use sinew_routing::{PatternModel, Routing};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndSolver};
 use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 use sinew_testkit::{cdhrm5, config};
@@ -54,15 +55,19 @@ fn evaluating_the_pipeline_allocates_nothing() {
             Vector6::new(0.0, f, 0.0, 0.0, 0.0, 0.0),
         ];
         // Warm-up: the first evaluation and the first request of K_W.
-        model.evaluate(&mut data, &qs[0], &loads[0], &levels).unwrap();
+        model.evaluate(&mut data, &qs[0], &loads[0], TensionChoice::Levels(&levels)).unwrap();
         let _ = data.k_w();
 
         let (allocations, ()) = count(|| {
             for q in &qs {
                 for f0 in &loads {
-                    model.evaluate(&mut data, q, f0, &levels).unwrap();
+                    model.evaluate(&mut data, q, f0, TensionChoice::Levels(&levels)).unwrap();
                     assert_eq!(data.end_solver(), solver, "{name}");
-                    model.evaluate_compliance(&mut data, q, f0, &levels).unwrap();
+                    // The same by stages: a pose, two tension stages, the end.
+                    model.set_pose(&mut data, q, f0).unwrap();
+                    model.set_tensions(&mut data, TensionChoice::Default).unwrap();
+                    model.set_tensions(&mut data, TensionChoice::Levels(&levels)).unwrap();
+                    assert!(model.solve_end(&mut data).unwrap().is_stable());
                     // K_W is filled on request, into the storage kept from the last request.
                     assert!(data.k_w()[(0, 0)].is_finite());
                 }

@@ -7,6 +7,7 @@ use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, joint_stiffness};
 use sinew_testkit::newton::elastic_cable_torque;
 use sinew_testkit::numeric::{H, central_difference, max_abs};
@@ -31,7 +32,10 @@ fn k_is_minus_the_derivative_of_the_cable_torque() {
             drawn += 1;
             let q: Vec<f64> = config::random_q(&robot, &mut rng);
             let levels: Vec<f64> = (0..joints).map(|_| rng.random_range(0.0..0.3)).collect();
-            if model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).is_err() {
+            if model
+                .evaluate_joints(&mut data, &q, &Vector6::zeros(), TensionChoice::Levels(&levels))
+                .is_err()
+            {
                 continue;
             }
             checked += 1;
@@ -115,7 +119,14 @@ fn decoupled_k_q_is_block_diagonal_and_routed_is_not() {
         let mut data = ArmStiffnessData::new(&model);
         let n = robot.dof();
         let q: Vec<f64> = (0..n).map(|i| 0.1 * ((i as f64) * 1.7).sin()).collect();
-        model.joint_level(&mut data, &q, &Vector6::zeros(), &vec![0.0; n / 2]).unwrap();
+        model
+            .evaluate_joints(
+                &mut data,
+                &q,
+                &Vector6::zeros(),
+                TensionChoice::Levels(&vec![0.0; n / 2]),
+            )
+            .unwrap();
         let k = data.k_q();
         let mut off_block: f64 = 0.0;
         for j in 0..n {
@@ -147,13 +158,13 @@ fn the_stiffness_slope_predicts_a_change_of_tension_level() {
     let f0 = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
     for joint in 0..5 {
         let mut levels = [0.2; 5];
-        model.joint_level(&mut data, &q, &f0, &levels).unwrap();
+        model.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
         let k_before = data.k_q().to_owned();
         let lambda_before = data.intervals()[joint].lambda_at_level(0.2);
         let mut slope = Mat::zeros(10, 10);
         model.stiffness_slope(&mut data, joint, slope.as_mut()).unwrap();
         levels[joint] = 0.9;
-        model.joint_level(&mut data, &q, &f0, &levels).unwrap();
+        model.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
         let delta = data.intervals()[joint].lambda_at_level(0.9) - lambda_before;
         let predicted = &k_before + &slope * faer::Scale(delta);
         let err = max_abs((data.k_q().to_owned() - &predicted).as_ref()) / max_abs(data.k_q());
@@ -177,18 +188,18 @@ fn move_level_holding_proximal_lambdas(
     joint: usize,
     level: f64,
 ) -> Vec<f64> {
-    model.joint_level(data, q, f0, levels).unwrap();
+    model.evaluate_joints(data, q, f0, TensionChoice::Levels(levels)).unwrap();
     let held: Vec<f64> =
         (0..joint).map(|k| data.intervals()[k].lambda_at_level(levels[k])).collect();
     let mut levels = levels.to_vec();
     levels[joint] = level;
     for k in (0..joint).rev() {
-        model.joint_level(data, q, f0, &levels).unwrap();
+        model.evaluate_joints(data, q, f0, TensionChoice::Levels(&levels)).unwrap();
         let interval = &data.intervals()[k];
         levels[k] = (held[k] - interval.lambda_min) / interval.width();
         assert!((0.0..=1.0).contains(&levels[k]), "joint {k}: held λ leaves the interval");
     }
-    model.joint_level(data, q, f0, &levels).unwrap();
+    model.evaluate_joints(data, q, f0, TensionChoice::Levels(&levels)).unwrap();
     levels
 }
 
@@ -208,7 +219,9 @@ fn routed_tension_sensitivity_keeps_every_joint_balanced_and_proximal_lambdas_he
     let (mut worst_torque, mut worst_held, mut worst_finite) = (0.0_f64, 0.0_f64, 0.0_f64);
     let mut worst_moved = 0.0_f64;
     for joint in 0..5 {
-        model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        model
+            .evaluate_joints(&mut data, &q, &Vector6::zeros(), TensionChoice::Levels(&levels))
+            .unwrap();
         let mut delta = vec![0.0; 15];
         model
             .statics()
@@ -288,7 +301,7 @@ fn routed_stiffness_slope_predicts_a_change_of_tension_level() {
     let levels = [0.1; 5];
     let mut worst: f64 = 0.0;
     for joint in 0..5 {
-        model.joint_level(&mut data, &q, &f0, &levels).unwrap();
+        model.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
         let k_before = data.k_q().to_owned();
         let lambda_before = lambda_of(&data, joint);
         let mut slope = Mat::zeros(10, 10);

@@ -9,6 +9,7 @@ use faer::Mat;
 use nalgebra::{Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::TensionChoice;
 use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, EndSolver, EndStiffnessData, StiffnessError, end_stiffness,
     joint_stiffness,
@@ -89,7 +90,7 @@ fn the_routed_pipeline_matches_the_reference_at_10_50_and_200_dof() {
             let q = if k == 0 { centre.clone() } else { config::near(&centre, 0.02, &mut rng) };
             let levels = vec![0.2 + 0.1 * k as f64; n / 2];
             for f0 in &loads {
-                let outcome = model.evaluate(&mut data, &q, f0, &levels);
+                let outcome = model.evaluate(&mut data, &q, f0, TensionChoice::Levels(&levels));
                 if let Err(StiffnessError::Statics(_)) = outcome {
                     continue;
                 }
@@ -144,8 +145,8 @@ fn batched_and_segment_by_segment_geometry_give_the_same_arm_bit_for_bit() {
             let q = if k == 0 { centre.clone() } else { config::near(&centre, 0.02, &mut rng) };
             let levels = vec![0.3; robot.dof() / 2];
             let (ra, rb) = (
-                batched.evaluate(&mut a, &q, &f0, &levels),
-                plain.evaluate(&mut b, &q, &f0, &levels),
+                batched.evaluate(&mut a, &q, &f0, TensionChoice::Levels(&levels)),
+                plain.evaluate(&mut b, &q, &f0, TensionChoice::Levels(&levels)),
             );
             assert_eq!(format!("{ra:?}"), format!("{rb:?}"), "{name} #{k}");
             assert!(a.k_controllable() == b.k_controllable(), "{name} #{k}: K_c");
@@ -185,7 +186,8 @@ fn the_stability_verdict_agrees_on_both_sides_of_the_boundary() {
             let robot = robot.with_gravity(Vector3::new(0.0, 0.0, -g));
             let model = ArmStiffness::new(&robot, &routing).unwrap();
             let mut data = ArmStiffnessData::new(&model);
-            let outcome = model.evaluate(&mut data, &q, &Vector6::zeros(), &levels);
+            let outcome =
+                model.evaluate(&mut data, &q, &Vector6::zeros(), TensionChoice::Levels(&levels));
             let r = reference(&robot, &routing, &q, &Vector6::zeros(), &data);
             (verdict(&outcome), verdict(&r.outcome))
         };

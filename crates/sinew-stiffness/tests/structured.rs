@@ -11,7 +11,7 @@ use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{PatternModel, Routing};
-use sinew_statics::{JointEndData, equilibrium_torque_derivative};
+use sinew_statics::{JointEndData, TensionChoice, equilibrium_torque_derivative};
 use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, EndSolver, EndStiffnessData, StiffnessError, end_stiffness,
 };
@@ -202,7 +202,8 @@ fn the_structured_solve_matches_the_dense_reference() {
                     let levels: Vec<f64> =
                         (0..joints).map(|_| rng.random_range(0.0..=1.0)).collect();
                     let f0 = random_load(&mut rng, kind, force);
-                    let outcome = model.evaluate(&mut data, &q, &f0, &levels);
+                    let outcome =
+                        model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels));
                     if let Err(StiffnessError::Statics(_)) = outcome {
                         infeasible += 1;
                         continue;
@@ -254,7 +255,7 @@ fn unstable_equilibria_report_the_reference_smallest_eigenvalue() {
                 Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.0),
                 Vector6::new(0.0, 0.0, -push, 0.0, 0.0, 0.05 * push),
             ] {
-                let outcome = model.evaluate(&mut data, &q, &f0, &[0.0; 5]);
+                let outcome = model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&[0.0; 5]));
                 if let Err(StiffnessError::Statics(_)) = outcome {
                     continue;
                 }
@@ -290,7 +291,7 @@ fn a_straight_arm_is_rank_deficient_on_both_paths() {
         let q = vec![0.0; robot.dof()];
         let levels = vec![0.3; robot.dof() / 2];
         for f0 in [Vector6::zeros(), Vector6::new(0.0, 0.0, -1.0, 0.0, 0.0, 0.0)] {
-            let outcome = model.evaluate(&mut data, &q, &f0, &levels);
+            let outcome = model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels));
             assert!(
                 matches!(outcome, Err(StiffnessError::RankDeficient { .. })),
                 "{name}: {outcome:?}"
@@ -312,7 +313,7 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     // A loaded pose (E4 rounded: the pose itself does not matter here, only the path).
     let q = cdhrm5::LOADED_POSE;
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    let outcome = model.evaluate(&mut data, &q, &f0, &[0.5; 5]);
+    let outcome = model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&[0.5; 5]));
     // K_q is full (a cable crosses every proximal joint): the dense path. It is exactly
     // symmetric (each product of J_cᵀ K_l J_c computed once), so with a pure force the dense
     // path solves with the Cholesky factor of its verdict.
@@ -325,7 +326,7 @@ fn the_routed_model_and_the_dense_reference_are_the_same_path() {
     let routing = cdhrm5::routing(&robot, PatternModel::Decoupled);
     let model = ArmStiffness::new(&robot, &routing).unwrap();
     let mut data = ArmStiffnessData::new(&model);
-    model.evaluate(&mut data, &q, &f0, &[0.5; 5]).unwrap();
+    model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&[0.5; 5])).unwrap();
     assert_eq!(data.end_solver(), EndSolver::Structured);
 }
 
@@ -343,7 +344,9 @@ fn k_q_outside_the_joint_blocks_stays_exactly_zero() {
     for _ in 0..10 {
         let q: Vec<f64> = (0..n).map(|_| rng.random_range(-0.1..0.1)).collect();
         let levels: Vec<f64> = (0..n / 2).map(|_| rng.random_range(0.0..1.0)).collect();
-        model.joint_level(&mut data, &q, &Vector6::zeros(), &levels).unwrap();
+        model
+            .evaluate_joints(&mut data, &q, &Vector6::zeros(), TensionChoice::Levels(&levels))
+            .unwrap();
         let mut kc = Mat::<f64>::zeros(n, n);
         let mut ki = Mat::<f64>::zeros(n, n);
         sinew_stiffness::joint_stiffness(
@@ -392,7 +395,7 @@ fn the_generators_rebuild_k_w_and_j_x() {
             let err = rel_diff(filled.as_ref(), reference.as_ref());
             assert!(err <= 1e-13, "{}: K_W from the generators off by {err:e}", setup.name);
             let levels = vec![0.5; n / 2];
-            if model.joint_level(&mut data, &q, &f0, &levels).is_ok() {
+            if model.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&levels)).is_ok() {
                 pipeline_checked += 1;
                 let mut j_x = Mat::zeros(6, n);
                 robot.point_jacobian(&rdata, &tip, j_x.as_mut()).unwrap();
@@ -414,11 +417,11 @@ fn a_workspace_made_for_another_arm_is_a_typed_mismatch() {
     let longer = ArmStiffness::new(&chain_robot, &chain_routing).unwrap();
     let mut data = ArmStiffnessData::new(&decoupled);
     let (q, f0, levels) = ([0.1; 10], Vector6::zeros(), [0.5; 5]);
-    decoupled.joint_level(&mut data, &q, &f0, &levels).unwrap();
+    decoupled.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
     assert!(decoupled.check(&data).is_ok());
     for arm in [&routed, &longer] {
         assert!(matches!(arm.check(&data), Err(StiffnessError::WorkspaceMismatch { .. })));
-        let err = arm.evaluate(&mut data, &q, &f0, &levels).unwrap_err();
+        let err = arm.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap_err();
         assert!(matches!(err, StiffnessError::WorkspaceMismatch { .. }), "{err:?}");
     }
     // A routing built for another robot is refused when the model is made.

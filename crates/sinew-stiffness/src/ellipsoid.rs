@@ -13,7 +13,7 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::error::IndicatorError;
+use crate::error::StiffnessError;
 
 /// The stiffness ellipsoid of a 3 × 3 translational stiffness.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,10 +31,10 @@ impl StiffnessEllipsoid {
     /// The ellipsoid of `k_fd` (N/m).
     ///
     /// # Errors
-    /// [`IndicatorError::NonFinite`].
-    pub fn new(k_fd: &Matrix3<f64>) -> Result<StiffnessEllipsoid, IndicatorError> {
+    /// [`StiffnessError::NonFinite`].
+    pub fn new(k_fd: &Matrix3<f64>) -> Result<StiffnessEllipsoid, StiffnessError> {
         if !k_fd.iter().all(|v| v.is_finite()) {
-            return Err(IndicatorError::NonFinite { what: "K_fd" });
+            return Err(StiffnessError::NonFinite { what: "K_fd" });
         }
         let sym = (k_fd + k_fd.transpose()) * 0.5;
         let eigen = SymmetricEigen::new(sym);
@@ -84,11 +84,11 @@ impl StiffnessEllipsoid {
     /// Stiffness along a direction, `uᵀ K_fd u` with `u` normalised (N/m).
     ///
     /// # Errors
-    /// [`IndicatorError::InvalidDirection`] for a zero or non-finite `u`.
-    pub fn directional_stiffness(&self, u: &Vector3<f64>) -> Result<f64, IndicatorError> {
+    /// [`StiffnessError::InvalidDirection`] for a zero or non-finite `u`.
+    pub fn directional_stiffness(&self, u: &Vector3<f64>) -> Result<f64, StiffnessError> {
         let norm = u.norm();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(IndicatorError::InvalidDirection { direction: [u[0], u[1], u[2]] });
+            return Err(StiffnessError::InvalidDirection { direction: [u[0], u[1], u[2]] });
         }
         let u = u / norm;
         Ok(u.dot(&(self.k_fd * u)))

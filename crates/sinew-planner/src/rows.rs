@@ -1,0 +1,73 @@
+//! The linear rows of a plan in the coordinates `λ` of the equilibrium set: the tension limits,
+//! the total and per-joint budgets, and the joints held at a level.
+
+use sinew_statics::EquilibriumSet;
+
+use crate::bundle::Linear;
+
+/// `Nᵀ 1`: how the total tension changes per unit of each `λ`.
+pub(crate) fn column_sums(set: &EquilibriumSet) -> Vec<f64> {
+    let null = set.null_basis();
+    (0..set.dimension()).map(|i| (0..set.cable_count()).map(|c| null[(c, i)]).sum()).collect()
+}
+
+/// The limits `f_min ≤ f_p + N λ ≤ f_max`, the budget `Σ f ≤ B` and the per-joint budgets
+/// `Σ_{c ∈ cables} f_c ≤ B_j` as rows in `λ`.
+pub(crate) fn linear_rows(
+    set: &EquilibriumSet,
+    budget: Option<f64>,
+    joint_budgets: &[(std::ops::Range<usize>, f64)],
+) -> Linear {
+    let null = set.null_basis();
+    let (m, k) = (set.cable_count(), set.dimension());
+    let p = set.particular();
+    let mut linear = Linear::default();
+    for c in 0..m {
+        let row: Vec<f64> = (0..k).map(|i| null[(c, i)]).collect();
+        linear.rhs.push(set.upper()[c] - p[c]);
+        linear.rows.push(row.clone());
+        linear.rhs.push(p[c] - set.lower()[c]);
+        linear.rows.push(row.iter().map(|v| -v).collect());
+    }
+    if let Some(b) = budget {
+        linear.rows.push(column_sums(set));
+        linear.rhs.push(b - p.iter().sum::<f64>());
+    }
+    for (cables, b) in joint_budgets {
+        linear.rows.push((0..k).map(|i| cables.clone().map(|c| null[(c, i)]).sum()).collect());
+        linear.rhs.push(b - cables.clone().map(|c| p[c]).sum::<f64>());
+    }
+    linear
+}
+
+/// A joint held at a level: its cables and their tensions there.
+pub(crate) type HeldTensions = (std::ops::Range<usize>, Vec<f64>);
+
+/// Hold each fixed joint's own tensions: its null coordinate (the one column of `N` on its
+/// cables, decoupled) fixed to the value that gives them, as two rows a rounding apart.
+pub(crate) fn fix_rows(
+    set: &EquilibriumSet,
+    fixed: &[(std::ops::Range<usize>, Vec<f64>)],
+    linear: &mut Linear,
+) {
+    let null = set.null_basis();
+    let k = set.dimension();
+    let p = set.particular();
+    for (cables, target) in fixed {
+        let Some(column) = (0..k).find(|&i| cables.clone().any(|c| null[(c, i)].abs() > 0.5))
+        else {
+            continue;
+        };
+        let value: f64 =
+            cables.clone().zip(target).map(|(c, t)| null[(c, column)] * (t - p[c])).sum();
+        let tol = 1e-9 * (1.0 + value.abs());
+        let mut up = vec![0.0; k];
+        up[column] = 1.0;
+        linear.rows.push(up);
+        linear.rhs.push(value + tol);
+        let mut down = vec![0.0; k];
+        down[column] = -1.0;
+        linear.rows.push(down);
+        linear.rhs.push(tol - value);
+    }
+}
