@@ -31,7 +31,7 @@
 //! [`fit::start_points`] and keeps the best. Deterministic; a few seconds in a debug build.
 //!
 //! # The files
-//! [`model`]: the geometry and its residuals; [`fit`]: the setups, the solver and the
+//! [`model`]: the geometry and its residuals; [`fit`](mod@fit): the setups, the solver and the
 //! tolerances; [`files`]: the robot files written and compared. This file prints the report.
 
 mod files;
