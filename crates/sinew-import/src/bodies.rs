@@ -286,3 +286,17 @@ pub(crate) fn about_com(about_joint: [[f64; 3]; 3], mass: f64, com: [f64; 3]) ->
     let i_g = i_o - mass * (Matrix3::identity() * r.dot(&r) - r * r.transpose());
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| i_g[(i, j)]))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::JointKind;
+
+    #[test]
+    fn joint_kinds_round_trip() {
+        for name in ["R_X", "R_Y", "R_Z", "U_XY", "U_XZ", "U_YZ"] {
+            let kind = JointKind::from_caspr(name);
+            assert_eq!(kind.map(JointKind::caspr_name), Some(name));
+        }
+        assert_eq!(JointKind::from_caspr("S_EULER_XYZ"), None);
+    }
+}

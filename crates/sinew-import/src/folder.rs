@@ -1,22 +1,18 @@
-//! A CASPR model → the three files of a Sinew robot folder: the URDF, `robot.toml` and the
-//! explicit `cables.toml`.
+//! A CASPR model → a Sinew robot folder: the importer's decisions (the names, the tip, the
+//! tension limits, the order of each cable's holes, every warning) and the [`RobotFolder`] they
+//! make. The files' text is written by `write/` from these decisions.
 
 use std::collections::HashSet;
-use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::bodies::Link;
 use crate::cables::Cable;
 use crate::error::{ImportError, Result};
-use crate::{CasprModel, ImportOptions};
+use crate::write::Tip;
+use crate::write::toml_files::{CableToml, CablesToml, RobotToml};
+use crate::write::urdf::write_urdf;
+use crate::{BASE_LINK, CasprModel, ImportOptions, TIP_LINK};
 
-/// The name of the tip link written into the URDF (`robot.toml`'s `tip_link`).
-pub const TIP_LINK: &str = "tip";
-/// The root link of the written URDF (CASPR's link 0).
-pub const BASE_LINK: &str = "base_link";
-/// The gravitational acceleration CASPR applies (`SystemModel.GRAVITY_CONSTANT`), m/s², along
-/// −z of the base frame (`SystemModelBodies`: `G_b = R_0kᵀ [0; 0; −m g]`).
-pub const CASPR_GRAVITY: f64 = 9.81;
 /// A `force_max` at or above this (N) is reported as a placeholder rather than a cable's rating.
 pub const PLACEHOLDER_FORCE_MAX: f64 = 1.0e5;
 
@@ -140,8 +136,14 @@ pub(crate) fn build(model: &CasprModel, options: &ImportOptions) -> Result<Robot
 
     let urdf_file = format!("{name}.urdf");
     let urdf = write_urdf(model, &name, &names, &tip);
-    let robot_toml = write_robot_toml(model, &urdf_file, &tip);
-    let cables_toml = write_cables_toml(model, options, &names, &limits);
+    let robot_toml = RobotToml {
+        bodies_file: &model.bodies_file,
+        urdf_file: &urdf_file,
+        tip_link: TIP_LINK,
+        tip: &tip,
+    }
+    .text();
+    let cables_toml = cables_toml(model, options, &names, &limits).text();
     Ok(RobotFolder {
         name,
         urdf_file,
@@ -245,13 +247,6 @@ fn names_list(names: &[&str]) -> String {
         out.push_str(&format!(" and {} more", names.len() - SHOWN));
     }
     out
-}
-
-/// Where the tip sits: (link number, point in its frame, what it is).
-struct Tip {
-    link: usize,
-    point: [f64; 3],
-    what: String,
 }
 
 fn tip(model: &CasprModel, warnings: &mut Vec<String>) -> Result<Tip> {
@@ -389,278 +384,51 @@ fn joint_group_warnings(links: &[Link], warnings: &mut Vec<String>) {
     }
 }
 
-/// `{}` of an f64: the shortest text that reads back to the same number.
-fn n(v: f64) -> String {
-    // -0 prints as 0.
-    if v == 0.0 { "0".to_owned() } else { format!("{v}") }
-}
-
-fn xyz(v: [f64; 3]) -> String {
-    format!("{} {} {}", n(v[0]), n(v[1]), n(v[2]))
-}
-
-/// A float as TOML reads it (always with a `.` or an exponent).
-fn t(v: f64) -> String {
-    if v == 0.0 { "0.0".to_owned() } else { format!("{v:?}") }
-}
-
-fn toml_vec(v: &[f64]) -> String {
-    format!("[{}]", v.iter().map(|&x| t(x)).collect::<Vec<_>>().join(", "))
-}
-
-/// A TOML basic string.
-fn toml_str(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if c.is_control() => {
-                let _ = write!(out, "\\u{:04X}", c as u32);
-            }
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
-}
-
-/// Text safe inside an XML comment (no `--`) or a TOML comment (one line).
-fn comment(s: &str) -> String {
-    s.replace("--", "- -").replace(['\n', '\r'], " ")
-}
-
-/// Text safe in an XML attribute.
-fn attr(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-fn write_urdf(model: &CasprModel, name: &str, names: &[String], tip: &Tip) -> String {
-    let mut u = String::new();
-    let _ = writeln!(u, "<?xml version=\"1.0\"?>");
-    let _ = writeln!(
-        u,
-        "<!-- Imported from CASPR by `sinew import caspr` (sinew-import): bodies {}, cable set `{}`.",
-        comment(&model.bodies_file),
-        comment(&model.cable_set.id)
-    );
-    let _ = writeln!(
-        u,
-        "     Each CASPR link is its joint frame: R_* is one revolute joint at <parent><location>, U_* two"
-    );
-    let _ = writeln!(
-        u,
-        "     (the first axis into the massless `<link>_cross`, the second with zero translation). Inertias"
-    );
-    let _ = writeln!(
-        u,
-        "     are about the centre of mass (ref=\"joint\" converted by the parallel-axis theorem). Joint limits"
-    );
-    let _ = writeln!(
-        u,
-        "     are CASPR's q_min/q_max, or ±π where the file states none. effort and velocity are unused by Sinew. -->"
-    );
-    let _ = writeln!(u, "<robot name=\"{}\">", attr(name));
-    let _ = writeln!(u, "  <link name=\"{BASE_LINK}\"/>");
-    for link in &model.links {
-        let me = &names[link.num];
-        let parent = &names[link.num - 1];
-        let _ = writeln!(u);
-        let _ = writeln!(
-            u,
-            "  <!-- CASPR link {} `{}`: {} -->",
-            link.num,
-            comment(&link.name),
-            link.joint.caspr_name()
-        );
-        if !link.limits_stated {
-            let _ = writeln!(u, "  <!-- no q_min/q_max in the CASPR file: limits ±π -->");
-        }
-        let axes = link.joint.axes();
-        for (i, axis) in axes.iter().enumerate() {
-            let (from, to, origin) = match (axes.len(), i) {
-                (1, _) => (parent.clone(), me.clone(), link.parent_location),
-                (_, 0) => (parent.clone(), format!("{me}_cross"), link.parent_location),
-                _ => (format!("{me}_cross"), me.clone(), [0.0; 3]),
-            };
-            let _ =
-                writeln!(u, "  <joint name=\"{}_{}\" type=\"revolute\">", attr(me), axis.name());
-            let _ = writeln!(
-                u,
-                "    <parent link=\"{}\"/><child link=\"{}\"/>",
-                attr(&from),
-                attr(&to)
-            );
-            let _ = writeln!(
-                u,
-                "    <origin xyz=\"{}\" rpy=\"0 0 0\"/><axis xyz=\"{}\"/>",
-                xyz(origin),
-                xyz(axis.unit())
-            );
-            let _ = writeln!(
-                u,
-                "    <limit lower=\"{}\" upper=\"{}\" effort=\"0\" velocity=\"0\"/>",
-                n(link.q_min[i]),
-                n(link.q_max[i])
-            );
-            let _ = writeln!(u, "  </joint>");
-            if axes.len() == 2 && i == 0 {
-                let _ = writeln!(u, "  <link name=\"{}_cross\"/>", attr(me));
-            }
-        }
-        if link.mass == 0.0 && link.inertia_com == [[0.0; 3]; 3] {
-            let _ = writeln!(u, "  <link name=\"{}\"/>", attr(me));
-        } else {
-            let i = link.inertia_com;
-            let _ = writeln!(u, "  <link name=\"{}\">", attr(me));
-            let _ = writeln!(u, "    <inertial>");
-            let _ = writeln!(u, "      <origin xyz=\"{}\" rpy=\"0 0 0\"/>", xyz(link.com));
-            let _ = writeln!(u, "      <mass value=\"{}\"/>", n(link.mass));
-            let _ = writeln!(
-                u,
-                "      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>",
-                n(i[0][0]),
-                n(i[0][1]),
-                n(i[0][2]),
-                n(i[1][1]),
-                n(i[1][2]),
-                n(i[2][2])
-            );
-            let _ = writeln!(u, "    </inertial>");
-            let _ = writeln!(u, "  </link>");
-        }
-    }
-    let _ = writeln!(u);
-    let _ = writeln!(u, "  <!-- The tip: {} -->", comment(&tip.what));
-    let _ = writeln!(u, "  <joint name=\"tip_joint\" type=\"fixed\">");
-    let _ = writeln!(
-        u,
-        "    <parent link=\"{}\"/><child link=\"{TIP_LINK}\"/>",
-        attr(&names[tip.link])
-    );
-    let _ = writeln!(u, "    <origin xyz=\"{}\" rpy=\"0 0 0\"/>", xyz(tip.point));
-    let _ = writeln!(u, "  </joint>");
-    let _ = writeln!(u, "  <link name=\"{TIP_LINK}\"/>");
-    let _ = writeln!(u, "</robot>");
-    u
-}
-
-fn write_robot_toml(model: &CasprModel, urdf_file: &str, tip: &Tip) -> String {
-    let mut r = String::new();
-    let _ = writeln!(
-        r,
-        "# Imported from CASPR by `sinew import caspr` (sinew-import): bodies {}.",
-        comment(&model.bodies_file)
-    );
-    let _ = writeln!(r, "urdf = {}", toml_str(urdf_file));
-    let _ = writeln!(r, "# The tip: {}.", comment(&tip.what));
-    let _ = writeln!(r, "tip_link = {}", toml_str(TIP_LINK));
-    let _ = writeln!(
-        r,
-        "# CASPR's gravity: -m g along z of the base frame, g = {CASPR_GRAVITY} m/s² (SystemModel.GRAVITY_CONSTANT)."
-    );
-    let _ = writeln!(r, "gravity = {}", toml_vec(&[0.0, 0.0, -CASPR_GRAVITY]));
-    r
-}
-
-fn write_cables_toml(
-    model: &CasprModel,
+/// What `cables.toml` says: the options' material and free length, the decided limits, and
+/// each cable's holes base first (a cable listed tip first reversed) on the links' URDF names.
+fn cables_toml<'a>(
+    model: &'a CasprModel,
     options: &ImportOptions,
-    names: &[String],
+    names: &'a [String],
     limits: &Limits,
-) -> String {
-    let mut c = String::new();
+) -> CablesToml<'a> {
     let set = &model.cable_set;
-    let _ = writeln!(
-        c,
-        "# Imported from CASPR by `sinew import caspr` (sinew-import): cables {}, cable set `{}`{}.",
-        comment(&model.cables_file),
-        comment(&set.id),
-        if set.is_default { " (the file's default_cable_set)" } else { "" }
-    );
-    let _ = writeln!(
-        c,
-        "# Each cable's holes are its CASPR attachments in order, as points in the link frame (the joint"
-    );
-    let _ = writeln!(
-        c,
-        "# frame; attachment_reference=\"com\" offsets converted by adding the link's <com_location>)."
-    );
-    let _ = writeln!(
-        c,
-        "# CASPR's ideal cables have no stiffness: the material and the free length are the import's"
-    );
-    let _ = writeln!(
-        c,
-        "# options (defaults: E = 200 GPa steel, d = 1 mm, free length 0.5 m); here E = {} Pa, d = {} m,",
-        t(options.youngs_modulus),
-        t(options.diameter)
-    );
-    let _ = writeln!(c, "# free length {} m.", t(options.free_length));
-    match &limits.per_cable {
-        None => {
-            let _ = writeln!(c, "# tension_limits: force_min (clamped to ≥ 0) and force_max, N.");
-        }
-        Some(_) => {
-            let _ = writeln!(
-                c,
-                "# The cables' force limits differ: each [[cable]] has its own tension_limits; the top-level value is"
-            );
-            let _ = writeln!(c, "# the widest [min of force_min, max of force_max], N.");
-        }
+    let cables = set
+        .cables
+        .iter()
+        .enumerate()
+        .map(|(k, cable)| {
+            let mut holes: Vec<_> =
+                cable.attachments.iter().map(|a| (names[a.link].as_str(), a.point)).collect();
+            if reversed(cable) {
+                holes.reverse();
+            }
+            CableToml {
+                name: &cable.name,
+                tension_limits: limits.per_cable.as_ref().map(|each| each[k]),
+                holes,
+            }
+        })
+        .collect();
+    CablesToml {
+        cables_file: &model.cables_file,
+        cable_set: &set.id,
+        default_set: set.is_default,
+        youngs_modulus: options.youngs_modulus,
+        diameter: options.diameter,
+        free_length: options.free_length,
+        tension_limits: limits.common,
+        cables,
     }
-    let _ = writeln!(c, "tension_limits = {}", toml_vec(&limits.common));
-    let _ = writeln!(c, "free_length = {}", t(options.free_length));
-    let _ = writeln!(c);
-    let _ = writeln!(c, "[material]");
-    let _ = writeln!(c, "youngs_modulus = {}", t(options.youngs_modulus));
-    let _ = writeln!(c, "diameter = {}", t(options.diameter));
-    for (k, cable) in set.cables.iter().enumerate() {
-        let _ = writeln!(c);
-        let _ = writeln!(c, "[[cable]]");
-        let _ = writeln!(c, "name = {}", toml_str(&cable.name));
-        if let Some(each) = &limits.per_cable {
-            let _ = writeln!(c, "tension_limits = {}", toml_vec(&each[k]));
-        }
-        let _ = writeln!(c, "holes = [");
-        let mut holes: Vec<_> = cable.attachments.iter().collect();
-        if reversed(cable) {
-            holes.reverse();
-        }
-        for a in holes {
-            let _ = writeln!(
-                c,
-                "  {{ link = {}, point = {} }},",
-                toml_str(&names[a.link]),
-                toml_vec(&a.point)
-            );
-        }
-        let _ = writeln!(c, "]");
-    }
-    c
 }
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-    use crate::JointKind;
+    use super::sanitize;
 
     #[test]
     fn names_are_made_safe() {
         assert_eq!(sanitize(" a b/c "), "a_b_c");
-        assert_eq!(toml_str("a\"b\\c"), "\"a\\\"b\\\\c\"");
-        assert_eq!(t(2.0e11), "200000000000.0");
-        assert_eq!(t(1.0e-7), "1e-7");
-        assert_eq!(n(-0.0), "0");
-        assert_eq!(comment("a--b"), "a- -b");
-    }
-
-    #[test]
-    fn joint_kinds_round_trip() {
-        for name in ["R_X", "R_Y", "R_Z", "U_XY", "U_XZ", "U_YZ"] {
-            let kind = JointKind::from_caspr(name);
-            assert_eq!(kind.map(JointKind::caspr_name), Some(name));
-        }
-        assert_eq!(JointKind::from_caspr("S_EULER_XYZ"), None);
+        assert_eq!(sanitize("a\"b\\c\nd"), "a_b_c_d");
     }
 }

@@ -85,6 +85,7 @@ mod cables;
 mod error;
 mod folder;
 mod operational;
+mod write;
 mod xml;
 
 use std::path::Path;
@@ -92,11 +93,16 @@ use std::path::Path;
 pub use bodies::{Axis, JointKind, Link};
 pub use cables::{Attachment, Cable, CableSet};
 pub use error::{ImportError, Place, Result};
-pub use folder::{
-    BASE_LINK, CASPR_GRAVITY, PLACEHOLDER_FORCE_MAX, RobotFolder, TIP_LINK, sanitize,
-};
+pub use folder::{PLACEHOLDER_FORCE_MAX, RobotFolder, sanitize};
 pub use operational::OperationalPoint;
 
+/// The name of the tip link written into the URDF (`robot.toml`'s `tip_link`).
+pub const TIP_LINK: &str = "tip";
+/// The root link of the written URDF (CASPR's link 0).
+pub const BASE_LINK: &str = "base_link";
+/// The gravitational acceleration CASPR applies (`SystemModel.GRAVITY_CONSTANT`), m/s², along
+/// −z of the base frame (`SystemModelBodies`: `G_b = R_0kᵀ [0; 0; −m g]`).
+pub const CASPR_GRAVITY: f64 = 9.81;
 /// Default Young's modulus of the cables, Pa: steel, 200 GPa.
 pub const DEFAULT_YOUNGS_MODULUS: f64 = 200.0e9;
 /// Default cable diameter, m: 1 mm.

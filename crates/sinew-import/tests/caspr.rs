@@ -383,3 +383,45 @@ fn a_cable_listed_tip_first_is_written_base_first() {
     let links: Vec<&str> = a1.holes.iter().map(|h| h.link).collect();
     assert_eq!(links, ["base_link", "base_side"]);
 }
+
+#[test]
+fn names_with_quotes_backslashes_and_newlines_round_trip() {
+    // In XML, `&quot;` is a quote and `&#10;` a newline an attribute keeps.
+    let bodies =
+        read("universal_bodies.xml").replace(r#"name="base_side""#, r#"name="a&quot;b\c""#);
+    let set = r#"s&quot;\&#10;--x"#;
+    let cables = read("universal_cables.xml")
+        .replacen(r#"<cable_ideal name="a1""#, r#"<cable_ideal name="a&quot;b\c&#10;d""#, 1)
+        .replace(r#"default_cable_set="basic""#, &format!(r#"default_cable_set="{set}""#))
+        .replacen(r#"<cable_set id="basic">"#, &format!(r#"<cable_set id="{set}">"#), 1);
+    let folder = import_caspr(
+        Source { name: "b\"\\\n--.xml", text: &bodies },
+        Source { name: "c\"\\\r\n.xml", text: &cables },
+        None,
+        &ImportOptions::named("r\"b\\c"),
+    )
+    .unwrap();
+    // The robot's and the links' names are made URDF-safe (`sanitize`) and the renaming is
+    // reported; a cable keeps its name as CASPR gives it.
+    assert_eq!((folder.name.as_str(), folder.urdf_file.as_str()), ("r_b_c", "r_b_c.urdf"));
+    assert!(
+        folder.warnings.iter().any(|w| w.contains("`a\"b\\c` → `a_b_c`")),
+        "{:?}",
+        folder.warnings
+    );
+    let dir = write(&folder);
+    let robot = sinew_robot::load(dir.path()).unwrap();
+    assert_eq!(robot.joints()[0].name, "a_b_c_x");
+    let routing = sinew_routing::load(dir.path(), &robot).unwrap();
+    let name = "a\"b\\c\nd";
+    let c = routing.cable_index(name).unwrap();
+    assert_eq!(routing.cables()[c].name, name);
+    let view = routing.view();
+    let links: Vec<&str> = view.cables[c].holes.iter().map(|h| h.link).collect();
+    assert_eq!(links, ["base_link", "a_b_c"]);
+    // The file names and the set's id stay inside their one-line comments.
+    assert!(folder.cables_toml.contains("cable set `s\"\\ - -x` (the file's default_cable_set)"));
+    assert!(folder.robot_toml.starts_with(
+        "# Imported from CASPR by `sinew import caspr` (sinew-import): bodies b\"\\ - -.xml.\n"
+    ));
+}

@@ -47,6 +47,7 @@ mod error;
 mod geometry;
 mod routing;
 pub mod spec;
+mod vec3;
 
 pub use error::{JointProblem, Result, RoutingError};
 pub use geometry::{

@@ -1,178 +1,194 @@
 //! The segment loop of [`super::compute_cable_geometry_from_kinematics`] batched by the pair of
-//! bodies a segment joins: every segment of a batch crosses the same joints and transforms its
-//! holes by the same two frames, so the batch is one loop over plain arrays of hole
-//! coordinates (structure of arrays) that the compiler vectorises, run with the widest vector
-//! instructions the processor has (pulp's runtime dispatch around the whole loop, in
-//! `compute.rs`: AVX2 on x86-64 when present, the baseline SSE2 otherwise). The operations and their order are those of the per-segment
-//! code, and Rust never fuses a multiply and an add, so the results are the same bit for bit;
-//! only the memory layout and the vector width change.
+//! bodies a segment joins ([`crate::routing::SegmentPlan`]): every segment of a batch crosses
+//! the same joints and transforms its holes by the same two frames, so the batch is one loop
+//! over plain arrays of hole coordinates (structure of arrays) that the compiler vectorises,
+//! run with the widest vector instructions the processor has (pulp's runtime dispatch around
+//! the whole loop, [`batched`]: AVX2 on x86-64 when present, the baseline SSE2 otherwise). The
+//! operations and their order are those of the per-segment code (`segment.rs`), and Rust never
+//! fuses a multiply and an add, so the results are the same bit for bit; only the memory
+//! layout and the vector width change.
 //!
 //! The routed model is where this pays: the segments across joint `j` are the segments of
 //! every cable of joint `j` and beyond (three per joint in the pattern, so 150 on average in a
 //! 200-DOF arm). In the decoupled model a batch is a joint's own three cables and the plain
-//! loop is kept (see [`SegmentPlan::new`]).
+//! loop is kept (the routing has no plan).
 
-use std::ops::Range;
+use super::Order;
+use super::segment::{Kinematics, Outputs, degenerate, mismatch, one_segment};
+use crate::error::Result;
+use crate::routing::{MIN_SEGMENT_LENGTH, Routing, SegmentPlan};
+use crate::vec3::{cross, dot, scale, sub, transform};
 
-use super::compute::{cross, dot, scale, sub, transform};
-use crate::routing::Segment;
-
-/// The least mean number of segments per batch for which the batched loop is used: below it
-/// (the decoupled model: three) the per-segment loop is as fast.
-const MIN_MEAN_BATCH: usize = 4;
-
-/// Segments grouped by the bodies they join, in an order that keeps every cable's segments in
-/// their routing order (so each cable's length and row of `J_c` are summed in the same order
-/// as the per-segment loop). Immutable, part of the [`crate::Routing`].
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct SegmentPlan {
-    /// The batches in processing order.
-    pub(crate) batches: Vec<Batch>,
-    /// Segment index of each entry (batch by batch).
-    pub(crate) segment: Vec<usize>,
-    /// Its cable.
-    pub(crate) cable: Vec<usize>,
-    /// The offset of its Hessian block in the workspace.
-    pub(crate) hessian: Vec<usize>,
-    /// Proximal hole on its body, `x`, `y`, `z` of every entry.
-    pub(crate) proximal: [Vec<f64>; 3],
-    /// Distal hole on its body.
-    pub(crate) distal: [Vec<f64>; 3],
-    /// The constant length of each entry whose holes are on one body (zero for the others),
-    /// computed in the body frame as the segment-by-segment loop does.
-    pub(crate) rigid_length: Vec<f64>,
-    /// The longest batch (the size of the workspace's scratch).
-    pub(crate) longest: usize,
-    /// Whether every entry of `J_c` has at most one segment (and no batch crosses more than
-    /// two joints): the batched loop then writes each entry once instead of adding into a
-    /// zeroed `J_c`, and the entries no segment reaches stay zero from the workspace's
-    /// construction.
-    pub(crate) single_writer: bool,
-    /// Whether no two batches cross the same joint (then every entry of `Σ f_c H_c` is summed
-    /// within one batch, in the same order batch by batch as segment by segment).
-    pub(crate) disjoint: bool,
+/// The segment loop by batches ([`SegmentPlan`]): each batch of one or two joints computed
+/// by [`run_batch`] into `scratch`, then written to the workspace's results entry by entry in
+/// the plan's order (every cable's segments in routing order, as [`one_segment`] would add
+/// them); batches across more joints segment by segment. The whole loop runs inside pulp's
+/// dispatch (one detection per evaluation), compiled for AVX2 where the processor has it.
+pub(super) fn batched(
+    routing: &Routing,
+    plan: &SegmentPlan,
+    kinematics: Kinematics<'_>,
+    scratch_per_segment: (&mut [[f64; 3]], &mut [f64]),
+    scratch: &mut [Vec<f64>; 6],
+    out: &mut Outputs<'_>,
+) -> Result<()> {
+    pulp::Arch::new().dispatch(Batched {
+        routing,
+        plan,
+        kinematics,
+        scratch_per_segment,
+        scratch,
+        out,
+    })
 }
 
-/// One batch: the entries `entries` join body `proximal` to body `distal` across `dofs`.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Batch {
-    /// Its entries in the plan's arrays.
-    pub(crate) entries: Range<usize>,
-    /// The lower-numbered body.
-    pub(crate) proximal: usize,
-    /// The higher-numbered body.
-    pub(crate) distal: usize,
-    /// Its entries' cables when they are consecutive (`cable[e] = start + e − entries.start`):
-    /// its results are then written to `J_c` and the lengths as slices.
-    pub(crate) cables: Option<Range<usize>>,
+/// The arguments of [`batched`] as a pulp operation.
+struct Batched<'a, 'b> {
+    routing: &'a Routing,
+    plan: &'a SegmentPlan,
+    kinematics: Kinematics<'a>,
+    scratch_per_segment: (&'a mut [[f64; 3]], &'a mut [f64]),
+    scratch: &'a mut [Vec<f64>; 6],
+    out: &'a mut Outputs<'b>,
 }
 
-impl SegmentPlan {
-    /// The plan of `segments` (cables' segments consecutive, in routing order), or `None` when
-    /// batching does not pay (fewer than [`MIN_MEAN_BATCH`] segments per batch on average) or
-    /// would change the order in which a cable's segments are summed. With a plan, the
-    /// segments' Hessian blocks are laid out in the plan's order (their `hessian_offset`), so
-    /// that a batch's blocks are consecutive.
-    pub(crate) fn new(segments: &mut [Segment], cables: usize) -> Option<SegmentPlan> {
-        let mut keys: Vec<(usize, usize)> =
-            segments.iter().map(|s| (s.proximal.body, s.distal.body)).collect();
-        keys.sort_unstable();
-        keys.dedup();
-        if keys.is_empty() || segments.len() < MIN_MEAN_BATCH * keys.len() {
-            return None;
-        }
-        let mut order: Vec<usize> = (0..segments.len()).collect();
-        // By batch, then by segment index within a batch.
-        order.sort_by_key(|&s| (segments[s].proximal.body, segments[s].distal.body, s));
-        // Every cable's segments must come in increasing index (the per-segment loop's order).
-        let mut last = vec![None::<usize>; cables];
-        for &s in &order {
-            let c = segments[s].cable;
-            let slot = last.get_mut(c)?;
-            if slot.is_some_and(|prev| prev >= s) {
-                return None;
-            }
-            *slot = Some(s);
-        }
-        let mut batches: Vec<Batch> = Vec::with_capacity(keys.len());
-        for (e, &s) in order.iter().enumerate() {
-            let key = (segments[s].proximal.body, segments[s].distal.body);
-            match batches.last_mut() {
-                Some(b) if (b.proximal, b.distal) == key => b.entries.end = e + 1,
-                _ => batches.push(Batch {
-                    entries: e..e + 1,
-                    proximal: key.0,
-                    distal: key.1,
-                    cables: None,
-                }),
-            }
-        }
-        let mut offset = 0;
-        for &s in &order {
-            let seg = &mut segments[s];
-            seg.hessian_offset = offset;
-            offset += seg.dofs.len() * seg.dofs.len();
-        }
-        let mut covered =
-            vec![None::<usize>; segments.iter().map(|s| s.dofs.end).max().unwrap_or(0)];
-        let mut disjoint = true;
-        for (b, batch) in batches.iter_mut().enumerate() {
-            let first = segments[order[batch.entries.start]].cable;
-            let consecutive = order[batch.entries.clone()]
-                .iter()
-                .enumerate()
-                .all(|(i, &s)| segments[s].cable == first + i);
-            batch.cables = consecutive.then(|| first..first + batch.entries.len());
-            for slot in &mut covered[batch.proximal..batch.distal] {
-                disjoint &= slot.is_none_or(|other| other == b);
-                *slot = Some(b);
-            }
-        }
-        let coordinate = |k: usize, distal: bool| -> Vec<f64> {
-            order
-                .iter()
-                .map(|&s| {
-                    let seg = &segments[s];
-                    if distal { seg.distal_point[k] } else { seg.proximal_point[k] }
-                })
-                .collect()
-        };
-        let longest = batches.iter().map(|b| b.entries.len()).max().unwrap_or(0);
-        let dof = segments.iter().map(|s| s.dofs.end).max().unwrap_or(0);
-        let mut written = vec![false; cables * dof];
-        let mut single_writer = batches.iter().all(|b| b.distal - b.proximal <= 2);
-        for seg in segments.iter() {
-            for k in seg.dofs.clone() {
-                let slot = &mut written[seg.cable * dof + k];
-                single_writer &= !*slot;
-                *slot = true;
-            }
-        }
-        Some(SegmentPlan {
-            batches,
-            proximal: [coordinate(0, false), coordinate(1, false), coordinate(2, false)],
-            distal: [coordinate(0, true), coordinate(1, true), coordinate(2, true)],
-            cable: order.iter().map(|&s| segments[s].cable).collect(),
-            rigid_length: order
-                .iter()
-                .map(|&s| rigid_length(&segments[s]).unwrap_or(0.0))
-                .collect(),
-            hessian: order.iter().map(|&s| segments[s].hessian_offset).collect(),
-            segment: order,
-            longest,
-            single_writer,
-            disjoint,
-        })
+impl pulp::WithSimd for Batched<'_, '_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Result<()> {
+        let Batched { routing, plan, kinematics, scratch_per_segment, scratch, out } = self;
+        batched_loop(routing, plan, kinematics, scratch_per_segment, scratch, out)
     }
 }
 
-/// The constant length of a segment whose holes are on one body, in the body frame (the
-/// formula of the segment-by-segment loop); `None` for a segment across joints.
-pub(crate) fn rigid_length(seg: &Segment) -> Option<f64> {
-    seg.dofs.is_empty().then(|| {
-        let d = sub(&seg.distal_point, &seg.proximal_point);
-        dot(&d, &d).sqrt()
-    })
+#[inline(always)]
+fn batched_loop(
+    routing: &Routing,
+    plan: &SegmentPlan,
+    (frames, axes, origins): Kinematics<'_>,
+    (v, g): (&mut [[f64; 3]], &mut [f64]),
+    scratch: &mut [Vec<f64>; 6],
+    out: &mut Outputs<'_>,
+) -> Result<()> {
+    let dof = routing.dof;
+    let m = out.m;
+    let hessians = out.order >= Order::Hessians;
+    for batch in &plan.batches {
+        let joints = batch.distal - batch.proximal;
+        let entries = batch.entries.clone();
+        let lo = batch.proximal;
+        let (Some(proximal), Some(distal), Some(a), Some(p)) = (
+            frames.get(batch.proximal),
+            frames.get(batch.distal),
+            axes.get(lo..lo + joints),
+            origins.get(lo..lo + joints),
+        ) else {
+            return Err(mismatch(dof));
+        };
+        if joints > 2 {
+            for &s in &plan.segment[entries] {
+                let seg = &routing.segments[s];
+                one_segment(routing, s, seg, (frames, axes, origins), (&mut *v, &mut *g), out)?;
+            }
+            continue;
+        }
+        let n = entries.len();
+        if joints == 0 {
+            // Both holes on one body: constant lengths (the plan's; the workspace's segment
+            // lengths were written when it was made), added to their cables' in order.
+            let rigid = &plan.rigid_length[entries.clone()];
+            match &batch.cables {
+                Some(range) => add(&mut out.lengths[range.clone()], rigid),
+                None => {
+                    for (&c, &length) in plan.cable[entries].iter().zip(rigid) {
+                        out.lengths[c] += length;
+                    }
+                }
+            }
+            continue;
+        }
+        let [l, g0, g1, h00, h01, h11] = scratch.each_mut().map(|v| &mut v[..n]);
+        run_batch(
+            &BatchFrames { proximal, distal, axes: a, origins: p },
+            plan.proximal.each_ref().map(|c| &c[entries.clone()]),
+            plan.distal.each_ref().map(|c| &c[entries.clone()]),
+            BatchOut { length: l, g: [g0, g1], h: [h00, h01, h11] },
+            joints,
+            hessians,
+        );
+        let (segments, cables) = (&plan.segment[entries.clone()], &plan.cable[entries.clone()]);
+        // One vectorisable pass (NaN fails `>=`), the culprit searched only on failure.
+        if !l.iter().fold(true, |ok, &x| ok & (x >= MIN_SEGMENT_LENGTH)) {
+            let i = l.iter().position(|&x| x.is_nan() || x < MIN_SEGMENT_LENGTH).unwrap_or(0);
+            return Err(degenerate(routing, &routing.segments[segments[i]], l[i]));
+        }
+        for (&s, &length) in segments.iter().zip(l.iter()) {
+            out.segment_lengths[s] = length;
+        }
+        let derivatives = out.order >= Order::Jacobian;
+        match &batch.cables {
+            // Consecutive cables: whole slices of the lengths and of J_c's columns.
+            Some(range) => {
+                add(&mut out.lengths[range.clone()], l);
+                if derivatives {
+                    let write = if plan.single_writer { set } else { add };
+                    write(&mut out.jacobian[lo * m..][range.clone()], g0);
+                    if joints == 2 {
+                        write(&mut out.jacobian[(lo + 1) * m..][range.clone()], g1);
+                    }
+                }
+            }
+            None => {
+                for i in 0..n {
+                    let c = cables[i];
+                    out.lengths[c] += l[i];
+                    if derivatives {
+                        let zero = if plan.single_writer { 0.0 } else { out.jacobian[c + lo * m] };
+                        out.jacobian[c + lo * m] = zero + g0[i];
+                        if joints == 2 {
+                            let zero = if plan.single_writer {
+                                0.0
+                            } else {
+                                out.jacobian[c + (lo + 1) * m]
+                            };
+                            out.jacobian[c + (lo + 1) * m] = zero + g1[i];
+                        }
+                    }
+                }
+            }
+        }
+        if hessians {
+            // The batch's blocks are consecutive (the plan lays them out in its order).
+            let o = plan.hessian[entries.start];
+            let blocks = &mut out.hessians[o..o + n * joints * joints];
+            if joints == 1 {
+                blocks.copy_from_slice(h00);
+            } else {
+                for (i, block) in blocks.chunks_exact_mut(4).enumerate() {
+                    block.copy_from_slice(&[h00[i], h01[i], h01[i], h11[i]]);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `target[i] += values[i]`.
+#[inline(always)]
+fn add(target: &mut [f64], values: &[f64]) {
+    for (t, v) in target.iter_mut().zip(values) {
+        *t += v;
+    }
+}
+
+/// `target[i] = 0 + values[i]`: what `+=` on a zeroed target gives, bit for bit (`−0` becomes
+/// `+0`).
+#[inline(always)]
+fn set(target: &mut [f64], values: &[f64]) {
+    for (t, v) in target.iter_mut().zip(values) {
+        *t = 0.0 + v;
+    }
 }
 
 /// A batch's frames and joints: the proximal and distal body poses (`[R column-major, t]`)
@@ -213,7 +229,7 @@ pub(crate) fn run_batch(
     }
 }
 
-/// The per-segment computation of `compute.rs` (`transform`, `segment_derivatives::<N>`) over
+/// The per-segment computation of `segment.rs` (`transform`, `segment_derivatives::<N>`) over
 /// a batch, the same operations in the same order, one loop per batch.
 #[inline(always)]
 fn kernel<const N: usize, const H: bool>(

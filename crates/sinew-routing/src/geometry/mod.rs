@@ -28,13 +28,12 @@
 
 mod batch;
 mod compute;
+mod segment;
 
 use faer::{MatMut, MatRef};
 
 use crate::error::{Result, RoutingError};
-use crate::routing::{Routing, Segment, check_shape};
-
-pub(crate) use batch::SegmentPlan;
+use crate::routing::{Routing, Segment, check_shape, rigid_length};
 
 pub use compute::{compute_cable_geometry, compute_cable_geometry_from_kinematics};
 
@@ -75,7 +74,7 @@ pub struct RoutingData {
     /// Scratch: `u · v_i`.
     g: Vec<f64>,
     /// Scratch of the batched segment loop: length, `∂L/∂q` (two), Hessian (three) per entry of
-    /// the longest batch ([`SegmentPlan`]; empty without a plan).
+    /// the longest batch ([`crate::routing::SegmentPlan`]; empty without a plan).
     batch: [Vec<f64>; 6],
 }
 
@@ -92,7 +91,7 @@ impl RoutingData {
             segment_lengths: routing
                 .segments
                 .iter()
-                .map(|s| batch::rigid_length(s).unwrap_or(0.0))
+                .map(|s| rigid_length(s).unwrap_or(0.0))
                 .collect(),
             jacobian: vec![0.0; m * routing.dof],
             hessians: vec![0.0; routing.hessian_len],

@@ -12,7 +12,7 @@ use super::expand::{
     CheckedCable, check_cable, check_material, check_per_joint, expand_explicit, expand_pattern,
     valid_limits,
 };
-use super::{Cable, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment};
+use super::{Cable, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment, SegmentPlan};
 use crate::error::{Result, RoutingError};
 use crate::spec::{PatternModel, RoutingSpec};
 
@@ -176,7 +176,7 @@ impl Routing {
             joint_groups: groups.to_vec(),
             cable_joint: out_cables.iter().map(|c| c.joint).collect(),
             stiffness: out_cables.iter().map(|c| c.stiffness).collect(),
-            plan: crate::geometry::SegmentPlan::new(&mut segments, out_cables.len()),
+            plan: SegmentPlan::new(&mut segments, out_cables.len()),
             cables: out_cables,
             segments,
             hessian_len,

@@ -1,10 +1,12 @@
 //! The immutable routing: every cable as an ordered list of holes on the robot's bodies, and
 //! the structure the other crates derive their layouts from (which cables a joint owns, which
 //! joints a cable spans, the DOF blocks, decoupled or not). Built from the file in `build.rs`
-//! (the cables expanded and checked in `expand.rs`); the serialisable view in `view.rs`.
+//! (the cables expanded and checked in `expand.rs`, the segments batched for the geometry in
+//! `plan.rs`); the serialisable view in `view.rs`.
 
 mod build;
 mod expand;
+mod plan;
 mod view;
 
 use std::ops::Range;
@@ -18,6 +20,7 @@ use crate::error::{Result, RoutingError};
 use crate::spec::PatternModel;
 
 pub use build::load;
+pub(crate) use plan::{SegmentPlan, rigid_length};
 pub use view::{CableView, HoleView, RoutingView};
 
 /// The routing file of the decoupled model inside a robot folder (the default of [`load`]).
@@ -137,7 +140,7 @@ pub struct Routing {
     pub(crate) cables: Vec<Cable>,
     pub(crate) segments: Vec<Segment>,
     /// The segments batched by the bodies they join, when that pays (routed models).
-    pub(crate) plan: Option<crate::geometry::SegmentPlan>,
+    pub(crate) plan: Option<SegmentPlan>,
     pub(crate) cable_joint: Vec<usize>,
     pub(crate) stiffness: Vec<f64>,
     /// Total size of the segments' Hessian blocks.
