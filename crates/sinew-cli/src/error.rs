@@ -146,4 +146,69 @@ mod tests {
         let e = library_error(IndicatorError::NoSuchJoint { joint: 8, joints: 5 });
         assert!(e.message.starts_with("--joint 9: "), "{}", e.message);
     }
+
+    /// Every prefix the command puts before a library message, pinned word for word: the
+    /// option at fault, the infeasible load, or none.
+    #[test]
+    fn every_prefix_is_pinned() {
+        let out_of_limits = || RobotError::OutOfLimits {
+            joint: "joint2_y".into(),
+            position: 1.0,
+            lower: -0.5,
+            upper: 0.5,
+        };
+        let infeasible = || StaticsError::Infeasible {
+            joint: 0,
+            torque: [50.0, 0.0],
+            limits: [20.0, 600.0],
+            reason: sinew::statics::InfeasibleReason::RankDeficient,
+        };
+        let cases: Vec<(sinew::Error, &str)> = vec![
+            (out_of_limits().into(), "--q: "),
+            (
+                RobotError::NonFiniteAngle { joint: "joint1_x".into(), value: f64::NAN }.into(),
+                "--q: ",
+            ),
+            (StaticsError::InvalidLevel { joint: 4, level: -0.5 }.into(), "--levels: "),
+            (StaticsError::NonFiniteWrench { wrench: [f64::NAN; 6] }.into(), "--wrench: "),
+            (
+                StaticsError::NonFiniteTorque { joint: 0, torque: [f64::NAN, 0.0] }.into(),
+                "--torque: ",
+            ),
+            (PlanError::NonConservativeLoad { moment: [0.0, 1.0, 0.0] }.into(), "--wrench: "),
+            (
+                PlanError::InvalidInput { what: "k_des", problem: "is not symmetric".into() }
+                    .into(),
+                "--k-des: ",
+            ),
+            (
+                PlanError::InvalidInput { what: "budget", problem: "is negative".into() }.into(),
+                "--budget: ",
+            ),
+            (IndicatorError::NoSuchJoint { joint: 5, joints: 5 }.into(), "--joint 6: "),
+            (IndicatorError::NotThreeCables { joint: 1, cables: 2 }.into(), "--joint 2: "),
+            (IndicatorError::NotUniversal { joint: 0, dofs: 1 }.into(), "--joint 1: "),
+            (IndicatorError::GridTooSmall { points: 1, min: 2 }.into(), "--grid 1: "),
+            (
+                IndicatorError::GridRange { lower: 0.0, upper: 0.0 }.into(),
+                "--joint (its angle limits): ",
+            ),
+            (infeasible().into(), "infeasible load: "),
+            (PlanError::from(infeasible()).into(), "infeasible load: "),
+            (PlanError::BudgetsInfeasible.into(), "infeasible: "),
+            (StaticsError::NoSuchJoint { joint: 7, joints: 5 }.into(), ""),
+            (IndicatorError::InvalidDirection { direction: [0.0; 3] }.into(), ""),
+            (sinew::routing::RoutingError::NoSuchCable { cable: 9, cables: 3 }.into(), ""),
+            (sinew::stiffness::StiffnessError::Unstable { min_eigenvalue: -1.0 }.into(), ""),
+            (PlanError::NoEndStiffness.into(), ""),
+            (sinew::Error::Other { message: "x.urdf: cannot read".into() }, ""),
+        ];
+        for (e, prefix) in cases {
+            let expected = format!("{prefix}{e}");
+            let kind = e.kind();
+            let got = library_error(e);
+            assert_eq!(got.message, expected);
+            assert_eq!(got.kind, kind, "{expected}");
+        }
+    }
 }
