@@ -1,5 +1,6 @@
 //! Every crate's error says its own kind (`kind()` beside the enum) and the facade's
-//! [`sinew::Error`] delegates to it. Representative errors of every crate (each variant whose
+//! [`sinew::Error`] delegates to it; [`sinew::Error::input_at_fault`] names the input the
+//! command line and Python report. Representative errors of every crate (each variant whose
 //! kind a wildcard used to decide among them), by value and through the facade.
 
 use sinew::indicators::IndicatorError;
@@ -8,7 +9,7 @@ use sinew::robot::RobotError;
 use sinew::routing::{JointProblem, RoutingError};
 use sinew::statics::{InfeasibleReason, StaticsError, UnsupportedRouting};
 use sinew::stiffness::StiffnessError;
-use sinew::{Error, ErrorKind};
+use sinew::{Error, ErrorKind, InputAtFault};
 
 fn out_of_limits() -> RobotError {
     RobotError::OutOfLimits { joint: "joint1_x".into(), position: 1.0, lower: -0.5, upper: 0.5 }
@@ -275,4 +276,87 @@ fn nested_errors_arrive_by_one_path() {
     // Built by hand around the normalisation, the kind is still found.
     let e = Error::Stiffness(Box::new(StiffnessError::Statics(infeasible())));
     assert_eq!(e.kind(), ErrorKind::Infeasible);
+}
+
+#[test]
+fn the_input_at_fault_is_named() {
+    let cases: Vec<(Error, Option<InputAtFault>)> = vec![
+        (out_of_limits().into(), Some(InputAtFault::JointAngle { joint: "joint1_x".into() })),
+        (
+            RobotError::NonFiniteAngle { joint: "joint2_y".into(), value: f64::NAN }.into(),
+            Some(InputAtFault::JointAngle { joint: "joint2_y".into() }),
+        ),
+        // Reached through other crates, the robot's error keeps its input.
+        (
+            StiffnessError::Robot(out_of_limits()).into(),
+            Some(InputAtFault::JointAngle { joint: "joint1_x".into() }),
+        ),
+        (
+            StaticsError::InvalidLevel { joint: 4, level: -0.5 }.into(),
+            Some(InputAtFault::Levels { joint: 4 }),
+        ),
+        (
+            StaticsError::NonFiniteWrench { wrench: [f64::NAN; 6] }.into(),
+            Some(InputAtFault::Wrench),
+        ),
+        (
+            StaticsError::NonFiniteTorque { joint: 2, torque: [f64::NAN, 0.0] }.into(),
+            Some(InputAtFault::Torque { joint: 2 }),
+        ),
+        (
+            PlanError::NonConservativeLoad { moment: [0.0, 1.0, 0.0] }.into(),
+            Some(InputAtFault::Wrench),
+        ),
+        (
+            PlanError::InvalidInput { what: "k_des", problem: "is not symmetric".into() }.into(),
+            Some(InputAtFault::PlannerArgument { name: "k_des" }),
+        ),
+        (
+            IndicatorError::NoSuchJoint { joint: 8, joints: 5 }.into(),
+            Some(InputAtFault::Joint { joint: 8 }),
+        ),
+        (
+            IndicatorError::NotThreeCables { joint: 1, cables: 2 }.into(),
+            Some(InputAtFault::Joint { joint: 1 }),
+        ),
+        (
+            IndicatorError::NotUniversal { joint: 0, dofs: 1 }.into(),
+            Some(InputAtFault::Joint { joint: 0 }),
+        ),
+        (
+            IndicatorError::GridTooSmall { points: 1, min: 2 }.into(),
+            Some(InputAtFault::GridPoints { points: 1 }),
+        ),
+        (
+            IndicatorError::GridRange { lower: 0.0, upper: 0.0 }.into(),
+            Some(InputAtFault::JointLimits),
+        ),
+        // Errors that name no single input.
+        (StaticsError::NoSuchJoint { joint: 7, joints: 5 }.into(), None),
+        (StaticsError::NotBalanced { problem: "leave their limits".into() }.into(), None),
+        (IndicatorError::InvalidDirection { direction: [0.0; 3] }.into(), None),
+        (infeasible().into(), None),
+        (PlanError::BudgetsInfeasible.into(), None),
+        (RoutingError::NoSuchCable { cable: 9, cables: 3 }.into(), None),
+        (StiffnessError::Unstable { min_eigenvalue: -1.0 }.into(), None),
+        (Error::Other { message: "x.urdf: cannot read".into() }, None),
+    ];
+    for (e, expected) in cases {
+        assert_eq!(e.input_at_fault(), expected, "{e}");
+    }
+}
+
+#[test]
+fn messages_name_the_input_or_the_infeasible_load() {
+    let name = |input: &InputAtFault| format!("<{input:?}>");
+    let e: Error = StaticsError::InvalidLevel { joint: 4, level: -0.5 }.into();
+    assert_eq!(e.message_naming(name), format!("<Levels {{ joint: 4 }}>: {e}"));
+    let e: Error = infeasible().into();
+    assert_eq!(e.message_naming(name), format!("infeasible load: {e}"));
+    let e: Error = PlanError::from(infeasible()).into();
+    assert_eq!(e.message_naming(name), format!("infeasible load: {e}"));
+    let e: Error = PlanError::BudgetsInfeasible.into();
+    assert_eq!(e.message_naming(name), format!("infeasible: {e}"));
+    let e: Error = StiffnessError::Unstable { min_eigenvalue: -1.0 }.into();
+    assert_eq!(e.message_naming(name), e.to_string());
 }
