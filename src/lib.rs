@@ -20,8 +20,9 @@
 //!
 //! [`paper`] holds the paper's experiments (spec §6) as data, checks and fixed-precision
 //! tables, for `cargo xtask reproduce` and the snapshot tests; [`Error`] gathers every crate's
-//! error, each by one path, and [`Error::kind`] says what kind of failure it is ([`ErrorKind`]:
-//! input, infeasible, unstable, rank-deficient, numerical).
+//! error, each by one path, [`Error::kind`] says what kind of failure it is ([`ErrorKind`]:
+//! input, infeasible, unstable, rank-deficient, numerical) and [`Error::input_at_fault`] which
+//! input to change ([`InputAtFault`]).
 //!
 //! Depend on a single crate (e.g. `sinew-robot`) when that is all you need.
 #![deny(missing_docs)]
@@ -29,7 +30,7 @@
 mod error;
 pub mod paper;
 
-pub use error::{Error, ErrorKind};
+pub use error::{Error, ErrorKind, InputAtFault};
 pub use sinew_indicators as indicators;
 pub use sinew_planner as planner;
 pub use sinew_robot as robot;

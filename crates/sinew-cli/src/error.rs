@@ -2,11 +2,7 @@
 
 use std::fmt;
 
-use sinew::ErrorKind;
-use sinew::indicators::IndicatorError;
-use sinew::planner::PlanError;
-use sinew::robot::RobotError;
-use sinew::statics::StaticsError;
+use sinew::{ErrorKind, InputAtFault};
 
 /// Exit code for bad input: options, counts, joint numbers, angles outside the limits, robot
 /// files ([`ErrorKind::Input`]; clap's own usage errors exit with 2 as well).
@@ -59,47 +55,25 @@ impl CliError {
 
 /// A library error: its kind gives the exit code; the message is the library's, prefixed by
 /// the option the faulty value came from when the error says which (`--q`, `--levels`,
-/// `--joint N`, `--grid N`), and an infeasible load says so first.
+/// `--joint N`, `--grid N`), and an infeasible load says so first
+/// ([`sinew::Error::message_naming`]).
 pub fn library_error(e: impl Into<sinew::Error>) -> CliError {
     let e: sinew::Error = e.into();
-    let kind = e.kind();
-    let message = match (kind, option_of(&e)) {
-        (ErrorKind::Infeasible, _) if matches!(e, sinew::Error::Planner(_)) => {
-            format!("infeasible: {e}")
-        }
-        (ErrorKind::Infeasible, _) => format!("infeasible load: {e}"),
-        (_, Some(option)) => format!("{option}: {e}"),
-        (_, None) => e.to_string(),
-    };
-    CliError { kind, message }
+    CliError { kind: e.kind(), message: e.message_naming(option) }
 }
 
-/// The command-line option whose value a library input error is about, if it names one.
-fn option_of(e: &sinew::Error) -> Option<String> {
-    match e {
-        sinew::Error::Robot(RobotError::OutOfLimits { .. } | RobotError::NonFiniteAngle { .. }) => {
-            Some("--q".to_owned())
-        }
-        sinew::Error::Statics(s) => match &**s {
-            StaticsError::InvalidLevel { .. } => Some("--levels".to_owned()),
-            StaticsError::NonFiniteWrench { .. } => Some("--wrench".to_owned()),
-            StaticsError::NonFiniteTorque { .. } => Some("--torque".to_owned()),
-            _ => None,
-        },
-        sinew::Error::Planner(p) => match &**p {
-            PlanError::NonConservativeLoad { .. } => Some("--wrench".to_owned()),
-            PlanError::InvalidInput { what, .. } => Some(format!("--{}", what.replace('_', "-"))),
-            _ => None,
-        },
-        sinew::Error::Indicators(i) => match i {
-            IndicatorError::NoSuchJoint { joint, .. } => Some(format!("--joint {}", joint + 1)),
-            IndicatorError::NotThreeCables { joint, .. }
-            | IndicatorError::NotUniversal { joint, .. } => Some(format!("--joint {}", joint + 1)),
-            IndicatorError::GridTooSmall { points, .. } => Some(format!("--grid {points}")),
-            IndicatorError::GridRange { .. } => Some("--joint (its angle limits)".to_owned()),
-            _ => None,
-        },
-        _ => None,
+/// The command-line option an input at fault came from (joints counted from 1, as the
+/// command does).
+fn option(input: &InputAtFault) -> String {
+    match input {
+        InputAtFault::JointAngle { .. } => "--q".to_owned(),
+        InputAtFault::Levels { .. } => "--levels".to_owned(),
+        InputAtFault::Wrench => "--wrench".to_owned(),
+        InputAtFault::Torque { .. } => "--torque".to_owned(),
+        InputAtFault::Joint { joint } => format!("--joint {}", joint + 1),
+        InputAtFault::JointLimits => "--joint (its angle limits)".to_owned(),
+        InputAtFault::GridPoints { points } => format!("--grid {points}"),
+        InputAtFault::PlannerArgument { name } => format!("--{}", name.replace('_', "-")),
     }
 }
 
@@ -124,6 +98,10 @@ impl fmt::Display for CliError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sinew::indicators::IndicatorError;
+    use sinew::planner::PlanError;
+    use sinew::robot::RobotError;
+    use sinew::statics::StaticsError;
 
     #[test]
     fn kinds_map_to_the_documented_exit_codes() {
@@ -145,5 +123,77 @@ mod tests {
         assert!(e.message.starts_with("--levels: joint 3"), "{}", e.message);
         let e = library_error(IndicatorError::NoSuchJoint { joint: 8, joints: 5 });
         assert!(e.message.starts_with("--joint 9: "), "{}", e.message);
+    }
+
+    /// Every prefix the command puts before a library message, pinned word for word: the
+    /// option at fault, the infeasible load, or none.
+    #[test]
+    fn every_prefix_is_pinned() {
+        let out_of_limits = || RobotError::OutOfLimits {
+            joint: "joint2_y".into(),
+            position: 1.0,
+            lower: -0.5,
+            upper: 0.5,
+        };
+        let infeasible = || StaticsError::Infeasible {
+            joint: 0,
+            torque: [50.0, 0.0],
+            limits: [20.0, 600.0],
+            reason: sinew::statics::InfeasibleReason::RankDeficient,
+        };
+        let cases: Vec<(sinew::Error, &str)> = vec![
+            (out_of_limits().into(), "--q: "),
+            (
+                RobotError::NonFiniteAngle { joint: "joint1_x".into(), value: f64::NAN }.into(),
+                "--q: ",
+            ),
+            (StaticsError::InvalidLevel { joint: 4, level: -0.5 }.into(), "--levels: "),
+            (StaticsError::NonFiniteWrench { wrench: [f64::NAN; 6] }.into(), "--wrench: "),
+            (
+                StaticsError::NonFiniteTorque { joint: 0, torque: [f64::NAN, 0.0] }.into(),
+                "--torque: ",
+            ),
+            (PlanError::NonConservativeLoad { moment: [0.0, 1.0, 0.0] }.into(), "--wrench: "),
+            (
+                PlanError::InvalidInput {
+                    what: "k_des",
+                    problem: sinew::planner::InputProblem::NotSymmetricPositiveDefinite,
+                }
+                .into(),
+                "--k-des: ",
+            ),
+            (
+                PlanError::InvalidInput {
+                    what: "budget",
+                    problem: sinew::planner::InputProblem::Negative { unit: " N" },
+                }
+                .into(),
+                "--budget: ",
+            ),
+            (IndicatorError::NoSuchJoint { joint: 5, joints: 5 }.into(), "--joint 6: "),
+            (IndicatorError::NotThreeCables { joint: 1, cables: 2 }.into(), "--joint 2: "),
+            (IndicatorError::NotUniversal { joint: 0, dofs: 1 }.into(), "--joint 1: "),
+            (IndicatorError::GridTooSmall { points: 1, min: 2 }.into(), "--grid 1: "),
+            (
+                IndicatorError::GridRange { lower: 0.0, upper: 0.0 }.into(),
+                "--joint (its angle limits): ",
+            ),
+            (infeasible().into(), "infeasible load: "),
+            (PlanError::from(infeasible()).into(), "infeasible load: "),
+            (PlanError::BudgetsInfeasible.into(), "infeasible: "),
+            (StaticsError::NoSuchJoint { joint: 7, joints: 5 }.into(), ""),
+            (sinew::stiffness::StiffnessError::InvalidDirection { direction: [0.0; 3] }.into(), ""),
+            (sinew::routing::RoutingError::NoSuchCable { cable: 9, cables: 3 }.into(), ""),
+            (sinew::stiffness::StiffnessError::Unstable { min_eigenvalue: -1.0 }.into(), ""),
+            (PlanError::NoEndStiffness.into(), ""),
+            (sinew::Error::Other { message: "x.urdf: cannot read".into() }, ""),
+        ];
+        for (e, prefix) in cases {
+            let expected = format!("{prefix}{e}");
+            let kind = e.kind();
+            let got = library_error(e);
+            assert_eq!(got.message, expected);
+            assert_eq!(got.kind, kind, "{expected}");
+        }
     }
 }

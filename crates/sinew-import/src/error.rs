@@ -3,7 +3,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use sinew_robot::Compact;
+use sinew_robot::{Compact, ErrorKind};
 
 /// Where in a file an element starts: the file as named by the caller, 1-based line and column.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -337,6 +337,41 @@ fn list(ids: &[String]) -> String {
 }
 
 impl ImportError {
+    /// The kind of failure: every import error is about the files or the options given
+    /// ([`ErrorKind::Input`]).
+    pub fn kind(&self) -> ErrorKind {
+        use ImportError::*;
+        // No wildcard: a new variant must be classified here.
+        match self {
+            Io { .. }
+            | Xml { .. }
+            | UnexpectedRoot { .. }
+            | MissingElement { .. }
+            | MissingAttribute { .. }
+            | UnexpectedElement { .. }
+            | InvalidNumber { .. }
+            | InvalidAttribute { .. }
+            | NoLinks { .. }
+            | LinkOrder { .. }
+            | UnsupportedJoint { .. }
+            | MissingParent { .. }
+            | NotSerial { .. }
+            | InvalidJointLimits { .. }
+            | UnknownCableSet { .. }
+            | UnknownOperationalSet { .. }
+            | NoOperationalPoint { .. }
+            | TipNotOnLastLink { .. }
+            | UnsupportedCable { .. }
+            | UnsupportedAttachment { .. }
+            | UnknownAttachmentLink { .. }
+            | TooFewAttachments { .. }
+            | DuplicateCable { .. }
+            | EmptyCableSet { .. }
+            | InvalidTensionLimits { .. }
+            | InvalidOption { .. } => ErrorKind::Input,
+        }
+    }
+
     /// Where in which file the error is, when it is about a file's element.
     pub fn place(&self) -> Option<&Place> {
         use ImportError::*;
@@ -372,3 +407,26 @@ impl ImportError {
 
 /// The result of this crate's functions.
 pub type Result<T, E = ImportError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_import_error_is_input() {
+        let at = || Place { file: "bodies.xml".into(), line: 3, column: 5 };
+        let cases = [
+            ImportError::Io {
+                path: "bodies.xml".into(),
+                source: std::io::ErrorKind::NotFound.into(),
+            },
+            ImportError::Xml { at: at(), message: "unexpected end".into() },
+            ImportError::NoLinks { at: at() },
+            ImportError::EmptyCableSet { at: at(), id: "default".into() },
+            ImportError::InvalidOption { option: "youngs_modulus", value: -1.0, expected: "> 0" },
+        ];
+        for e in cases {
+            assert_eq!(e.kind(), ErrorKind::Input, "{e}");
+        }
+    }
+}

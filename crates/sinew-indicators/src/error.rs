@@ -1,6 +1,6 @@
 //! The one error type of this crate.
 
-use sinew_robot::{Compact, RobotError};
+use sinew_robot::{Compact, ErrorKind, RobotError};
 use sinew_routing::RoutingError;
 use sinew_statics::StaticsError;
 use sinew_stiffness::StiffnessError;
@@ -82,6 +82,24 @@ pub enum IndicatorError {
 }
 
 impl IndicatorError {
+    /// The kind of failure: a non-finite stiffness matrix is [`ErrorKind::Numerical`]; joints,
+    /// grids and routings the probe cannot take are the caller's input
+    /// ([`ErrorKind::Input`]); the errors of the crates below say their own kind.
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            IndicatorError::NoSuchJoint { .. }
+            | IndicatorError::NotThreeCables { .. }
+            | IndicatorError::NotUniversal { .. }
+            | IndicatorError::GridTooSmall { .. }
+            | IndicatorError::GridRange { .. } => ErrorKind::Input,
+            IndicatorError::Statics(e) => e.kind(),
+            IndicatorError::Stiffness(e) => e.kind(),
+            IndicatorError::Routing(e) => e.kind(),
+            IndicatorError::Robot(e) => e.kind(),
+        }
+    }
+
     /// Whether this is an infeasible load (the torque cannot be held within the limits).
     pub fn is_infeasible(&self) -> bool {
         matches!(self, IndicatorError::Statics(e)

@@ -1,6 +1,6 @@
 //! The one error type of this crate.
 
-use sinew_robot::Compact;
+use sinew_robot::{Compact, ErrorKind};
 
 /// Everything a plan can end in besides an answer.
 #[derive(Debug, thiserror::Error)]
@@ -99,6 +99,31 @@ pub enum PlanError {
     /// The cable geometry.
     #[error(transparent)]
     Routing(Box<sinew_routing::RoutingError>),
+}
+
+impl PlanError {
+    /// The kind of failure: no tensions meet what was asked ([`ErrorKind::Infeasible`], an
+    /// answer of the model like an infeasible load), no end stiffness at this pose
+    /// ([`ErrorKind::RankDeficient`]), a bad argument or a moment in the load
+    /// ([`ErrorKind::Input`]), a method that stopped without a certified answer
+    /// ([`ErrorKind::Numerical`]); the errors of the crates below say their own kind.
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            PlanError::NoStableTensions { .. }
+            | PlanError::RequirementUnreachable { .. }
+            | PlanError::BudgetTooSmall { .. }
+            | PlanError::BudgetsInfeasible => ErrorKind::Infeasible,
+            PlanError::NoEndStiffness => ErrorKind::RankDeficient,
+            PlanError::NonConservativeLoad { .. } | PlanError::InvalidInput { .. } => {
+                ErrorKind::Input
+            }
+            PlanError::NotConverged { .. } | PlanError::Solver { .. } => ErrorKind::Numerical,
+            PlanError::Statics(e) => e.kind(),
+            PlanError::Stiffness(e) => e.kind(),
+            PlanError::Routing(e) => e.kind(),
+        }
+    }
 }
 
 impl From<sinew_statics::StaticsError> for PlanError {

@@ -5,11 +5,7 @@
 use pyo3::PyErr;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
-use sinew::ErrorKind;
-use sinew::indicators::IndicatorError;
-use sinew::planner::PlanError;
-use sinew::robot::RobotError;
-use sinew::statics::StaticsError;
+use sinew::{ErrorKind, InputAtFault};
 
 create_exception!(sinew, SinewError, PyException, "Base class of every error Sinew raises.");
 create_exception!(
@@ -65,46 +61,24 @@ pub fn library(e: impl Into<sinew::Error>) -> PyErr {
     exception(kind, message)
 }
 
-/// The kind and message of a library error, as `sinew`'s `library_error` words it
-/// (crates/sinew-cli/src/error.rs), the option replaced by the Python parameter.
+/// The kind and message of a library error, as the `sinew` command words it
+/// ([`sinew::Error::message_naming`]), with the Python parameter where the command names its
+/// option.
 pub fn message(e: impl Into<sinew::Error>) -> (ErrorKind, String) {
     let e: sinew::Error = e.into();
-    let kind = e.kind();
-    let message = match (kind, parameter_of(&e)) {
-        (ErrorKind::Infeasible, _) if matches!(e, sinew::Error::Planner(_)) => {
-            format!("infeasible: {e}")
-        }
-        (ErrorKind::Infeasible, _) => format!("infeasible load: {e}"),
-        (_, Some(parameter)) => format!("{parameter}: {e}"),
-        (_, None) => e.to_string(),
-    };
-    (kind, message)
+    (e.kind(), e.message_naming(parameter))
 }
 
-fn parameter_of(e: &sinew::Error) -> Option<String> {
-    match e {
-        sinew::Error::Robot(RobotError::OutOfLimits { .. } | RobotError::NonFiniteAngle { .. }) => {
-            Some("q".to_owned())
-        }
-        sinew::Error::Statics(s) => match &**s {
-            StaticsError::InvalidLevel { .. } => Some("levels".to_owned()),
-            StaticsError::NonFiniteWrench { .. } => Some("wrench".to_owned()),
-            StaticsError::NonFiniteTorque { .. } => Some("torque".to_owned()),
-            _ => None,
-        },
-        sinew::Error::Planner(p) => match &**p {
-            PlanError::NonConservativeLoad { .. } => Some("wrench".to_owned()),
-            PlanError::InvalidInput { what, .. } => Some((*what).to_string()),
-            _ => None,
-        },
-        sinew::Error::Indicators(i) => match i {
-            IndicatorError::NoSuchJoint { joint, .. }
-            | IndicatorError::NotThreeCables { joint, .. }
-            | IndicatorError::NotUniversal { joint, .. } => Some(format!("joint {joint}")),
-            IndicatorError::GridTooSmall { points, .. } => Some(format!("points {points}")),
-            IndicatorError::GridRange { .. } => Some("joint (its angle limits)".to_owned()),
-            _ => None,
-        },
-        _ => None,
+/// The Python parameter an input at fault came from (joints 0-based, as in Python).
+fn parameter(input: &InputAtFault) -> String {
+    match input {
+        InputAtFault::JointAngle { .. } => "q".to_owned(),
+        InputAtFault::Levels { .. } => "levels".to_owned(),
+        InputAtFault::Wrench => "wrench".to_owned(),
+        InputAtFault::Torque { .. } => "torque".to_owned(),
+        InputAtFault::Joint { joint } => format!("joint {joint}"),
+        InputAtFault::JointLimits => "joint (its angle limits)".to_owned(),
+        InputAtFault::GridPoints { points } => format!("points {points}"),
+        InputAtFault::PlannerArgument { name } => (*name).to_owned(),
     }
 }

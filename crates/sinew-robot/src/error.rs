@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use crate::Compact;
+use crate::ErrorKind;
 
 /// Everything that can go wrong while loading a robot or evaluating it at a configuration.
 ///
@@ -223,6 +224,38 @@ pub enum RobotError {
         /// Joints of this robot.
         robot_dof: usize,
     },
+}
+
+impl RobotError {
+    /// The kind of failure: every robot error is about the files or what the caller passed
+    /// ([`ErrorKind::Input`]).
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            RobotError::Io { .. }
+            | RobotError::InvalidUrdf { .. }
+            | RobotError::InvalidDescription { .. }
+            | RobotError::DuplicateLink { .. }
+            | RobotError::DuplicateJoint { .. }
+            | RobotError::UnknownLink { .. }
+            | RobotError::KinematicLoop { .. }
+            | RobotError::MultipleRoots { .. }
+            | RobotError::BranchingChain { .. }
+            | RobotError::UnsupportedJoint { .. }
+            | RobotError::ZeroAxis { .. }
+            | RobotError::InvalidLimits { .. }
+            | RobotError::InvalidMass { .. }
+            | RobotError::NonFinite { .. }
+            | RobotError::NoJoints { .. }
+            | RobotError::NoSuchLink { .. }
+            | RobotError::InvalidGravity { .. }
+            | RobotError::DimensionMismatch { .. }
+            | RobotError::NonFiniteAngle { .. }
+            | RobotError::OutOfLimits { .. }
+            | RobotError::NoSuchBody { .. }
+            | RobotError::WorkspaceMismatch { .. } => ErrorKind::Input,
+        }
+    }
 }
 
 /// Result with [`RobotError`].

@@ -24,6 +24,7 @@
 mod description;
 mod display;
 mod error;
+mod error_kind;
 mod generate;
 mod gravity;
 mod kinematics;
@@ -33,6 +34,7 @@ mod urdf;
 pub use description::{DESCRIPTION_FILE, RobotDescription, load, load_urdf};
 pub use display::Compact;
 pub use error::{Result, RobotError};
+pub use error_kind::ErrorKind;
 pub use generate::UniformChain;
 pub use kinematics::RobotData;
 pub use model::{Body, BodyPoint, ChainSettings, Joint, LinkPlacement, Robot};

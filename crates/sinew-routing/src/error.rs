@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use sinew_robot::{Compact, RobotError};
+use sinew_robot::{Compact, ErrorKind, RobotError};
 
 /// Everything that can go wrong while loading a routing or evaluating it at a configuration.
 ///
@@ -270,6 +270,40 @@ pub enum RoutingError {
     /// An error of the robot model (kinematics, workspace, configuration).
     #[error(transparent)]
     Robot(#[from] RobotError),
+}
+
+impl RoutingError {
+    /// The kind of failure: a segment degenerate at a configuration and a failed serialization
+    /// are [`ErrorKind::Numerical`]; files, specs, sizes, indices and the evaluation order are
+    /// the caller's input ([`ErrorKind::Input`]); a robot error says its own kind.
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            RoutingError::Robot(e) => e.kind(),
+            RoutingError::DegenerateSegment { .. } | RoutingError::Serialize { .. } => {
+                ErrorKind::Numerical
+            }
+            RoutingError::Io { .. }
+            | RoutingError::Parse { .. }
+            | RoutingError::CableForm { .. }
+            | RoutingError::NotUniversal { .. }
+            | RoutingError::UnknownLink { .. }
+            | RoutingError::HoleOffChain { .. }
+            | RoutingError::TooFewHoles { .. }
+            | RoutingError::DuplicateCable { .. }
+            | RoutingError::WrongJoint { .. }
+            | RoutingError::ZeroLengthSegment { .. }
+            | RoutingError::InvalidMaterial { .. }
+            | RoutingError::InvalidTensionLimits { .. }
+            | RoutingError::InvalidValue { .. }
+            | RoutingError::PatternSize { .. }
+            | RoutingError::RobotMismatch { .. }
+            | RoutingError::WorkspaceMismatch { .. }
+            | RoutingError::DimensionMismatch { .. }
+            | RoutingError::NoSuchCable { .. }
+            | RoutingError::NotComputed { .. } => ErrorKind::Input,
+        }
+    }
 }
 
 /// Why a cable does not fit the joint it drives ([`RoutingError::WrongJoint`]).

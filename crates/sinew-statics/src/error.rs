@@ -1,6 +1,6 @@
 //! The one error type of this crate.
 
-use sinew_robot::Compact;
+use sinew_robot::{Compact, ErrorKind};
 
 /// Why a joint's cables cannot hold its torque.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -256,6 +256,35 @@ pub enum StaticsError {
     /// An error of the cable geometry.
     #[error(transparent)]
     Routing(#[from] sinew_routing::RoutingError),
+}
+
+impl StaticsError {
+    /// The kind of failure: an infeasible load ([`ErrorKind::Infeasible`], whatever the reason:
+    /// a rank-deficient joint block, lost force closure or the limits), a bad input
+    /// ([`ErrorKind::Input`]), or a computation that failed ([`ErrorKind::Numerical`]); robot
+    /// and routing errors say their own kind.
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            StaticsError::Infeasible { .. }
+            | StaticsError::NoEquilibrium(_)
+            | StaticsError::LevelsInfeasible(_) => ErrorKind::Infeasible,
+            StaticsError::NonFiniteTorque { .. }
+            | StaticsError::LevelsUnavailable(_)
+            | StaticsError::NotBalanced(_)
+            | StaticsError::NoPose
+            | StaticsError::NoSuchJoint { .. }
+            | StaticsError::InvalidLevel { .. }
+            | StaticsError::UnsupportedRouting { .. }
+            | StaticsError::DimensionMismatch { .. }
+            | StaticsError::NonFiniteWrench { .. } => ErrorKind::Input,
+            StaticsError::NonFiniteInput { .. }
+            | StaticsError::Numerical { .. }
+            | StaticsError::Solver { .. } => ErrorKind::Numerical,
+            StaticsError::Robot(e) => e.kind(),
+            StaticsError::Routing(e) => e.kind(),
+        }
+    }
 }
 
 /// Why no tensions within the limits balance the load (any cable set,

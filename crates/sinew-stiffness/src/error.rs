@@ -1,6 +1,6 @@
 //! The one error type of this crate.
 
-use sinew_robot::Compact;
+use sinew_robot::{Compact, ErrorKind};
 use sinew_statics::StaticsError;
 
 /// Everything that can go wrong computing a stiffness. Each underlying error arrives by one
@@ -90,6 +90,30 @@ pub enum StiffnessError {
     /// An error of the cable geometry.
     #[error(transparent)]
     Routing(#[from] sinew_routing::RoutingError),
+}
+
+impl StiffnessError {
+    /// The kind of failure: an unstable equilibrium ([`ErrorKind::Unstable`]), a rank-deficient
+    /// end-effector Jacobian ([`ErrorKind::RankDeficient`]), an input of the wrong size
+    /// ([`ErrorKind::Input`]) or a computation that failed ([`ErrorKind::Numerical`], which
+    /// includes a workspace made for another arm); the errors of the crates below say their
+    /// own kind.
+    pub fn kind(&self) -> ErrorKind {
+        // No wildcard: a new variant must be classified here.
+        match self {
+            StiffnessError::Unstable { .. } => ErrorKind::Unstable,
+            StiffnessError::RankDeficient { .. } => ErrorKind::RankDeficient,
+            StiffnessError::NonFinite { .. }
+            | StiffnessError::Eigen
+            | StiffnessError::WorkspaceMismatch { .. } => ErrorKind::Numerical,
+            StiffnessError::DimensionMismatch { .. }
+            | StiffnessError::InvalidDirection { .. }
+            | StiffnessError::StageMissing { .. } => ErrorKind::Input,
+            StiffnessError::Statics(e) => e.kind(),
+            StiffnessError::Robot(e) => e.kind(),
+            StiffnessError::Routing(e) => e.kind(),
+        }
+    }
 }
 
 impl From<StaticsError> for StiffnessError {
