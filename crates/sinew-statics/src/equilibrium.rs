@@ -324,12 +324,13 @@ impl EquilibriumSet {
 
     /// Whether the cables are in force closure at this pose: some strictly positive tension
     /// vector in `null(J_cᵀ)` (every torque can then be held with high enough tensions). One
-    /// small LP (solved with clarabel); a property, not a condition of feasibility.
+    /// small LP (solved with clarabel, see [`crate::convex`]); a property, not a condition of
+    /// feasibility.
     ///
     /// # Errors
     /// [`StaticsError::Solver`] when the LP solver fails.
     pub fn force_closure(&self) -> Result<bool, StaticsError> {
-        crate::policy::force_closure(self)
+        crate::convex::force_closure(self.null_basis())
     }
 }
 

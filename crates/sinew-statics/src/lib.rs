@@ -20,6 +20,7 @@
 #![deny(missing_docs)]
 
 mod arm;
+pub mod convex;
 mod distribution;
 mod equilibrium;
 mod error;

@@ -18,14 +18,14 @@
 //! rows (the vertex itself when they fix it). A polish that would leave a row violated is
 //! discarded. A load no tensions balance gets the solver's certificate of infeasibility read
 //! back as a joint motion `δq` ([`NoEquilibriumCause::Limits`]): along it the load needs more
-//! torque than the cables give within their limits.
+//! torque than the cables give within their limits. The programs are solved in
+//! [`crate::convex`].
 
 use std::ops::Range;
 
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use faer::Mat;
 
+use crate::convex::{Solved, dense_csc, solve};
 use crate::equilibrium::{EquilibriumSet, joints_along, norm};
 use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
 
@@ -101,7 +101,7 @@ pub fn distribute_with_policy(
     } else {
         match program.solve()? {
             Solved::Point { x, iterations } => (x, iterations),
-            Solved::Infeasible { z } => {
+            Solved::Infeasible { z, .. } => {
                 return Err(limits_certificate(
                     set,
                     &program.certificate_weights(&z),
@@ -131,7 +131,7 @@ pub fn distribute_with_policy(
         if k > 0 {
             // The set is not a point, yet its best point is outside: read the certificate of
             // the least-total program, which is infeasible then.
-            if let Ok(Solved::Infeasible { z }) =
+            if let Ok(Solved::Infeasible { z, .. }) =
                 Program::new(set, TensionPolicy::LeastTotal).solve()
             {
                 let weights = Program::new(set, TensionPolicy::LeastTotal).certificate_weights(&z);
@@ -180,11 +180,6 @@ struct Program {
     row_width: Vec<f64>,
 }
 
-enum Solved {
-    Point { x: Vec<f64>, iterations: u32 },
-    Infeasible { z: Vec<f64> },
-}
-
 impl Program {
     fn new(set: &EquilibriumSet, policy: TensionPolicy) -> Program {
         let (m, k) = (set.cable_count(), set.dimension());
@@ -228,27 +223,8 @@ impl Program {
 
     fn solve(&self) -> Result<Solved, StaticsError> {
         let n = self.n;
-        let p_matrix = if self.policy == TensionPolicy::LeastNorm {
-            CscMatrix::identity(n)
-        } else {
-            CscMatrix::zeros((n, n))
-        };
-        let a = csc(self.rows(), n, |r, c| self.g[r * n + c]);
-        let cones = [SupportedConeT::NonnegativeConeT(self.rows())];
-        let settings = settings();
-        let mut solver = DefaultSolver::new(&p_matrix, &self.q, &a, &self.h, &cones, settings)
-            .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
-        solver.solve();
-        let solution = &solver.solution;
-        match solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok(Solved::Point { x: solution.x.clone(), iterations: solution.iterations })
-            }
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                Ok(Solved::Infeasible { z: solution.z.clone() })
-            }
-            status => Err(StaticsError::Solver { status: format!("{status:?}") }),
-        }
+        let a = dense_csc(self.rows(), n, |r, c| self.g[r * n + c]);
+        solve(self.policy == TensionPolicy::LeastNorm, &self.q, &a, &self.h)
     }
 
     /// The cable weights `w = z_upper − z_lower` of a certificate of infeasibility `z` (2m).
@@ -293,31 +269,6 @@ impl Program {
             .collect();
         if feasible(&polished) { polished } else { x }
     }
-}
-
-/// The solver's settings: quiet, no equilibration (the rows are unit-scaled cable tensions
-/// already), otherwise clarabel's defaults.
-fn settings() -> DefaultSettings<f64> {
-    DefaultSettings { verbose: false, equilibrate_enable: false, ..DefaultSettings::default() }
-}
-
-/// Dense to CSC, skipping exact zeros.
-fn csc(rows: usize, cols: usize, at: impl Fn(usize, usize) -> f64) -> CscMatrix<f64> {
-    let mut colptr = Vec::with_capacity(cols + 1);
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    colptr.push(0);
-    for c in 0..cols {
-        for r in 0..rows {
-            let v = at(r, c);
-            if v != 0.0 {
-                rowval.push(r);
-                nzval.push(v);
-            }
-        }
-        colptr.push(rowval.len());
-    }
-    CscMatrix::new(rows, cols, colptr, rowval, nzval)
 }
 
 /// A certificate `w` (cable weights, in the range of `J_c`) read back as the joint motion
@@ -394,38 +345,4 @@ fn limits_certificate(
             direction,
         },
     }))
-}
-
-/// Whether some strictly positive tension vector lies in `null(J_cᵀ)`: maximise `t` with
-/// `N λ ≥ t`, `|λ_i| ≤ 1`; closure when `t > 1e-9`.
-pub(crate) fn force_closure(set: &EquilibriumSet) -> Result<bool, StaticsError> {
-    let (m, k) = (set.cable_count(), set.dimension());
-    if k == 0 {
-        return Ok(false);
-    }
-    let null = set.null_basis();
-    let n = k + 1;
-    let rows = m + 2 * k;
-    let a = csc(rows, n, |r, c| {
-        if r < m {
-            if c < k { -null[(r, c)] } else { 1.0 }
-        } else if c == (r - m) % k && c < k {
-            if r < m + k { 1.0 } else { -1.0 }
-        } else {
-            0.0
-        }
-    });
-    let mut b = vec![0.0; rows];
-    b[m..].fill(1.0);
-    let mut q = vec![0.0; n];
-    q[k] = -1.0;
-    let settings = settings();
-    let cones = [SupportedConeT::NonnegativeConeT(rows)];
-    let mut solver = DefaultSolver::new(&CscMatrix::zeros((n, n)), &q, &a, &b, &cones, settings)
-        .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
-    solver.solve();
-    match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solver.solution.x[k] > 1e-9),
-        status => Err(StaticsError::Solver { status: format!("{status:?}") }),
-    }
 }
