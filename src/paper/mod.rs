@@ -10,6 +10,7 @@
 //! rendered table changes only when a number really changes.
 
 mod arm;
+mod claim;
 mod claims;
 mod experiments;
 mod patterns;
@@ -22,7 +23,8 @@ pub use arm::{
     E4, E4Case, E4Joint, claims_e4, claims_e4_end, claims_e4_joints, e4, render_e4,
     render_routed_vs_decoupled,
 };
-pub use claims::{Claim, claims_e1_e3, render_claims};
+pub use claim::Claim;
+pub use claims::{claims_e1_e3, render_claims};
 pub use experiments::{
     E2_Q, E2_SAMPLES, E2_TORQUE, E3_POINTS, E3_RANGE, E3_TORQUE, E4_CASES, E4_F0,
     E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, PAPER_TABLE_2,

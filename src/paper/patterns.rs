@@ -6,7 +6,7 @@
 
 use std::fmt::Write as _;
 
-use super::claims::Claim;
+use super::claim::Claim;
 use super::fixed;
 use super::single_joint::Table2Row;
 

@@ -20,6 +20,7 @@
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use sinew_statics::convex::dense_csc;
 
 use crate::error::PlanError;
 
@@ -299,20 +300,7 @@ fn solve(
 ) -> Result<Option<Vec<f64>>, PlanError> {
     let p = if quadratic { CscMatrix::identity(n) } else { CscMatrix::zeros((n, n)) };
     let m = rows.len();
-    let mut colptr = Vec::with_capacity(n + 1);
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    colptr.push(0);
-    for c in 0..n {
-        for (r, (a, _)) in rows.iter().enumerate() {
-            if a[c] != 0.0 {
-                rowval.push(r);
-                nzval.push(a[c]);
-            }
-        }
-        colptr.push(rowval.len());
-    }
-    let a = CscMatrix::new(m, n, colptr, rowval, nzval);
+    let a = dense_csc(m, n, |r, c| rows[r].0[c]);
     let b: Vec<f64> = rows.iter().map(|(_, b)| *b).collect();
     let cones = [SupportedConeT::NonnegativeConeT(m)];
     let settings = DefaultSettings {

@@ -14,11 +14,11 @@
 //! [`StaticsError::UnsupportedRouting`].
 
 use faer::MatRef;
-use nalgebra::{Matrix3x2, Vector2};
+use nalgebra::Vector2;
 use sinew_routing::Routing;
 
 use crate::error::{StaticsError, UnsupportedRouting};
-use crate::interval::{TensionInterval, TensionLimits, tension_interval};
+use crate::interval::{TensionInterval, TensionLimits, joint_block, tension_interval};
 
 /// How the cables of a routing map onto the joints: three per universal joint.
 #[derive(Debug, Clone, PartialEq)]
@@ -157,8 +157,7 @@ pub fn distribute_tensions(
                 }
             }
         }
-        let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);
-        let interval = tension_interval(i, &block, &tau, limits)?;
+        let interval = tension_interval(i, &joint_block(jacobian, i), &tau, limits)?;
         let f = interval.tensions_at_level(levels[i]);
         tensions[3 * i..3 * i + 3].copy_from_slice(f.as_slice());
         intervals[i] = interval;

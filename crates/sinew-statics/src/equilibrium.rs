@@ -43,6 +43,10 @@ pub const SET_RANK_TOLERANCE: f64 = 1e-10;
 /// The relative equilibrium residual `|T0 + J_cᵀ f| / |T0|` accepted as balance.
 pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-9;
 
+/// A joint (a cable) is named in a [`NoEquilibrium`] when its largest component of the joint
+/// motion (of the certificate's cable weights) is at least this share of the largest overall.
+pub(crate) const NAMED_SHARE: f64 = 0.1;
+
 /// The equilibrium set `f = f_p + N λ` of a cable set under a load, and its tension limits.
 ///
 /// Built per configuration by [`EquilibriumSet::new`] (it allocates: an SVD of `J_c`); the
@@ -324,12 +328,13 @@ impl EquilibriumSet {
 
     /// Whether the cables are in force closure at this pose: some strictly positive tension
     /// vector in `null(J_cᵀ)` (every torque can then be held with high enough tensions). One
-    /// small LP (solved with clarabel); a property, not a condition of feasibility.
+    /// small LP (solved with clarabel, see [`crate::convex`]); a property, not a condition of
+    /// feasibility.
     ///
     /// # Errors
     /// [`StaticsError::Solver`] when the LP solver fails.
     pub fn force_closure(&self) -> Result<bool, StaticsError> {
-        crate::policy::force_closure(self)
+        crate::convex::force_closure(self.null_basis())
     }
 }
 
@@ -338,15 +343,16 @@ pub(crate) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// The joints (0-based) whose DOFs carry at least a tenth of the largest component of a joint
-/// motion `direction` (dof).
+/// The joints (0-based) whose DOFs carry at least [`NAMED_SHARE`] of the largest component of a
+/// joint motion `direction` (dof).
 pub(crate) fn joints_along(direction: &[f64], groups: &[Range<usize>]) -> Vec<usize> {
     let largest = direction.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     groups
         .iter()
         .enumerate()
         .filter(|(_, g)| {
-            (g.start..g.end).any(|d| direction.get(d).is_some_and(|v| v.abs() >= 0.1 * largest))
+            (g.start..g.end)
+                .any(|d| direction.get(d).is_some_and(|v| v.abs() >= NAMED_SHARE * largest))
         })
         .map(|(j, _)| j)
         .collect()

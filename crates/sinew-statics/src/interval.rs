@@ -22,6 +22,7 @@
 //! it the interval may still be non-empty (a cable with `n_k < 0` slackens as the others
 //! tighten), and a cable with `n_k = 0` keeps the tension `f_p,k` whatever `λ`.
 
+use faer::MatRef;
 use nalgebra::{Matrix3x2, Vector2, Vector3};
 
 use crate::error::{InfeasibleReason, StaticsError};
@@ -117,6 +118,18 @@ impl TensionInterval {
     pub fn width(&self) -> f64 {
         self.lambda_max - self.lambda_min
     }
+}
+
+/// Joint `joint`'s 3 × 2 block of the cable Jacobian `jacobian` (3n × 2n, three cables per
+/// universal joint in joint order): rows `3 joint..3 joint + 3` (its cables), columns
+/// `2 joint..2 joint + 2` (its two DOF), the `jacobian` argument of [`tension_interval`] and
+/// [`minimum_norm_tensions`].
+///
+/// # Panics
+/// When the block is outside `jacobian` (the callers have checked its shape).
+#[inline]
+pub(crate) fn joint_block(jacobian: MatRef<'_, f64>, joint: usize) -> Matrix3x2<f64> {
+    Matrix3x2::from_fn(|r, k| jacobian[(3 * joint + r, 2 * joint + k)])
 }
 
 /// `f_p = −J_c (J_cᵀ J_c)⁻¹ τ`: the minimum-norm tensions with `τ + J_cᵀ f_p = 0` (eq. 23),

@@ -17,9 +17,43 @@
 //! Infeasible loads are typed outcomes naming the joint — [`StaticsError::Infeasible`] with an
 //! [`InfeasibleReason`] in closed form, [`StaticsError::NoEquilibrium`] on the general path —
 //! never a NaN, never a panic. Force closure is reported, not required.
+//!
+//! # Tolerances
+//!
+//! Every threshold the crate decides by, one name each (the public ones are re-exported here;
+//! the others are private to the file named):
+//!
+//! - [`RANK_TOLERANCE`] (`1e-12`): a joint's 3 × 2 block of `J_c` has rank < 2 when
+//!   `det(J_cᵀ J_c) ≤ 1e-12 (trace)²` (closed form).
+//! - [`FORCE_CLOSURE_TOLERANCE`] (`1e-9`): a component of a joint's unit null direction at most
+//!   this in magnitude counts as zero (closed form); the same margin decides the force-closure
+//!   LP of [`EquilibriumSet::force_closure`] (`t > 1e-9`).
+//! - [`SET_RANK_TOLERANCE`] (`1e-10`): a singular value of `J_c` below this fraction of the
+//!   largest counts as zero (the rank of the equilibrium set).
+//! - [`EQUILIBRIUM_TOLERANCE`] (`1e-9`): the relative residual `|T0 + J_cᵀ f_p| / |T0|` accepted
+//!   as balance; above it the load is unreachable.
+//! - `NAMED_SHARE` (`equilibrium.rs`, `0.1`): a joint or a cable is named in a
+//!   [`NoEquilibrium`] when its component is at least this share of the largest.
+//! - `ACTIVE_TOLERANCE` (`policy.rs`, `1e-6`): a row of a policy's program within this fraction
+//!   of the bound width of its bound is active in the polish.
+//! - `SNAP_FRACTION` (`policy.rs`, `1e-3`): a polished tension within this fraction of
+//!   `ACTIVE_TOLERANCE` of the bound width of a limit is put exactly on it.
+//! - `OUTSIDE_TOLERANCE` (`policy.rs`, `1e-7`): a policy's tension outside its limits by more
+//!   than this fraction of the bound width means no tensions within the limits balance the load.
+//! - `POLISH_TOLERANCE` (`policy.rs`, `1e-9`): the most a polished point may violate a row, as a
+//!   fraction of the bound width, before the polish is discarded.
+//! - `SHORTFALL_TOLERANCE` (`policy.rs`, `1e-9`): a certificate along one joint replaces the
+//!   solver's when it falls short by more than this fraction of the largest tension limit.
+//! - `NOISE_TOLERANCE` (`policy.rs`, `1e-12`): components of a certificate's joint motion below
+//!   this fraction of the largest are rounding noise, set to zero.
+//! - `WIDTH_FLOOR` (`policy.rs`, `1` N): the bound width the relative tolerances scale with is
+//!   `max(f_max − f_min, 1 N)`.
+//!
+//! The interior-point solves use clarabel's default tolerances ([`convex`]).
 #![deny(missing_docs)]
 
 mod arm;
+pub mod convex;
 mod distribution;
 mod equilibrium;
 mod error;

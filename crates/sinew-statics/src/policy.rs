@@ -12,21 +12,21 @@
 //!   `f_min + t ≤ f ≤ f_max − t` (LP in `(λ, t)`): the tensions farthest from both limits.
 //!
 //! The interior-point answer is accurate to the solver's tolerance (about `1e-8` relative).
-//! The polish takes the rows within `1e-6 (f_max − f_min)` of their bound as active and solves
-//! them exactly: for the QP `λ = N_A⁺ (b_A − f_p,A)` (the least `|λ|` on the active rows, its
-//! optimum given the active set), for the LPs the projection of the answer onto the active
-//! rows (the vertex itself when they fix it). A polish that would leave a row violated is
-//! discarded. A load no tensions balance gets the solver's certificate of infeasibility read
-//! back as a joint motion `δq` ([`NoEquilibriumCause::Limits`]): along it the load needs more
-//! torque than the cables give within their limits.
+//! The polish takes the rows within `1e-6 (f_max − f_min)` ([`ACTIVE_TOLERANCE`]) of their bound
+//! as active and solves them exactly: for the QP `λ = N_A⁺ (b_A − f_p,A)` (the least `|λ|` on
+//! the active rows, its optimum given the active set), for the LPs the projection of the answer
+//! onto the active rows (the vertex itself when they fix it). A polish that would leave a row
+//! violated (by more than [`POLISH_TOLERANCE`]) is discarded. A load no tensions balance gets
+//! the solver's certificate of infeasibility read back as a joint motion `δq`
+//! ([`NoEquilibriumCause::Limits`]): along it the load needs more torque than the cables give
+//! within their limits. The programs are solved in [`crate::convex`].
 
 use std::ops::Range;
 
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use faer::Mat;
 
-use crate::equilibrium::{EquilibriumSet, joints_along, norm};
+use crate::convex::{Solved, dense_csc, solve};
+use crate::equilibrium::{EquilibriumSet, NAMED_SHARE, joints_along, norm};
 use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
 
 /// A named way to choose the tensions among all that balance the load.
@@ -70,8 +70,33 @@ pub struct Distribution {
     pub iterations: u32,
 }
 
-/// Rows within this fraction of `f_max − f_min` of their bound are active in the polish.
-const ACTIVE: f64 = 1e-6;
+/// Rows within this fraction of their cable's bound width (see [`WIDTH_FLOOR`]) of their bound
+/// are active in the polish.
+const ACTIVE_TOLERANCE: f64 = 1e-6;
+
+/// A polished tension within this fraction of [`ACTIVE_TOLERANCE`] (so `1e-9` of the bound
+/// width) of a limit is put exactly on it.
+const SNAP_FRACTION: f64 = 1e-3;
+
+/// A tension outside its limits by more than this fraction of the bound width, after the
+/// polish, means no point of the set is within them: the load is refused with a certificate.
+const OUTSIDE_TOLERANCE: f64 = 1e-7;
+
+/// A polished point may leave a row violated by at most this fraction of the bound width;
+/// beyond, the polish is discarded and the solver's answer kept.
+const POLISH_TOLERANCE: f64 = 1e-9;
+
+/// A certificate along one joint (or one DOF) replaces the solver's only when its shortfall
+/// per newton of cable weight exceeds this fraction of the largest tension limit.
+const SHORTFALL_TOLERANCE: f64 = 1e-9;
+
+/// Components of a certificate's joint motion below this fraction of the largest are rounding
+/// noise (about `1e-16` from the other joints' blocks) and are set to zero.
+const NOISE_TOLERANCE: f64 = 1e-12;
+
+/// The least bound width, N, that the relative tolerances above scale with:
+/// `max(f_max − f_min, WIDTH_FLOOR)`.
+const WIDTH_FLOOR: f64 = 1.0;
 
 /// The tensions of `policy` on `set` (into `tensions`, m, N). `groups` (the joints as DOF
 /// ranges) and `names` (the cables) name what is at fault in an infeasibility.
@@ -101,7 +126,7 @@ pub fn distribute_with_policy(
     } else {
         match program.solve()? {
             Solved::Point { x, iterations } => (x, iterations),
-            Solved::Infeasible { z } => {
+            Solved::Infeasible { z, .. } => {
                 return Err(limits_certificate(
                     set,
                     &program.certificate_weights(&z),
@@ -119,7 +144,7 @@ pub fn distribute_with_policy(
     let worst = (0..m)
         .map(|c| (lower[c] - tensions[c]).max(tensions[c] - upper[c]) / width(set, c))
         .fold(f64::NEG_INFINITY, f64::max);
-    if worst > 1e-7 {
+    if worst > OUTSIDE_TOLERANCE {
         let c = (0..m)
             .max_by(|&a, &b| {
                 let over = |c: usize| (lower[c] - tensions[c]).max(tensions[c] - upper[c]);
@@ -131,7 +156,7 @@ pub fn distribute_with_policy(
         if k > 0 {
             // The set is not a point, yet its best point is outside: read the certificate of
             // the least-total program, which is infeasible then.
-            if let Ok(Solved::Infeasible { z }) =
+            if let Ok(Solved::Infeasible { z, .. }) =
                 Program::new(set, TensionPolicy::LeastTotal).solve()
             {
                 let weights = Program::new(set, TensionPolicy::LeastTotal).certificate_weights(&z);
@@ -142,10 +167,10 @@ pub fn distribute_with_policy(
     }
     for c in 0..m {
         let f = tensions[c].clamp(lower[c], upper[c]);
-        let tol = ACTIVE * width(set, c);
-        tensions[c] = if (f - lower[c]).abs() <= tol * 1e-3 {
+        let tol = ACTIVE_TOLERANCE * width(set, c);
+        tensions[c] = if (f - lower[c]).abs() <= tol * SNAP_FRACTION {
             lower[c]
-        } else if (upper[c] - f).abs() <= tol * 1e-3 {
+        } else if (upper[c] - f).abs() <= tol * SNAP_FRACTION {
             upper[c]
         } else {
             f
@@ -161,8 +186,9 @@ pub fn distribute_with_policy(
     Ok(Distribution { policy, lambda, objective, iterations })
 }
 
+/// The bound width of cable `c`, floored at [`WIDTH_FLOOR`].
 fn width(set: &EquilibriumSet, c: usize) -> f64 {
-    (set.upper()[c] - set.lower()[c]).max(1.0)
+    (set.upper()[c] - set.lower()[c]).max(WIDTH_FLOOR)
 }
 
 /// A policy's program in `x = λ` (or `(λ, t)` for [`TensionPolicy::Safest`]): minimise
@@ -178,11 +204,6 @@ struct Program {
     q: Vec<f64>,
     /// The bound width of each row's cable (for the active tolerance).
     row_width: Vec<f64>,
-}
-
-enum Solved {
-    Point { x: Vec<f64>, iterations: u32 },
-    Infeasible { z: Vec<f64> },
 }
 
 impl Program {
@@ -228,27 +249,8 @@ impl Program {
 
     fn solve(&self) -> Result<Solved, StaticsError> {
         let n = self.n;
-        let p_matrix = if self.policy == TensionPolicy::LeastNorm {
-            CscMatrix::identity(n)
-        } else {
-            CscMatrix::zeros((n, n))
-        };
-        let a = csc(self.rows(), n, |r, c| self.g[r * n + c]);
-        let cones = [SupportedConeT::NonnegativeConeT(self.rows())];
-        let settings = settings();
-        let mut solver = DefaultSolver::new(&p_matrix, &self.q, &a, &self.h, &cones, settings)
-            .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
-        solver.solve();
-        let solution = &solver.solution;
-        match solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok(Solved::Point { x: solution.x.clone(), iterations: solution.iterations })
-            }
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                Ok(Solved::Infeasible { z: solution.z.clone() })
-            }
-            status => Err(StaticsError::Solver { status: format!("{status:?}") }),
-        }
+        let a = dense_csc(self.rows(), n, |r, c| self.g[r * n + c]);
+        solve(self.policy == TensionPolicy::LeastNorm, &self.q, &a, &self.h)
     }
 
     /// The cable weights `w = z_upper − z_lower` of a certificate of infeasibility `z` (2m).
@@ -268,10 +270,12 @@ impl Program {
         }
         let slack =
             |x: &[f64], r: usize| self.h[r] - (0..n).map(|c| self.g[r * n + c] * x[c]).sum::<f64>();
-        let active: Vec<usize> =
-            (0..self.rows()).filter(|&r| slack(&x, r) <= ACTIVE * self.row_width[r]).collect();
-        let feasible =
-            |x: &[f64]| (0..self.rows()).all(|r| slack(x, r) >= -1e-9 * self.row_width[r]);
+        let active: Vec<usize> = (0..self.rows())
+            .filter(|&r| slack(&x, r) <= ACTIVE_TOLERANCE * self.row_width[r])
+            .collect();
+        let feasible = |x: &[f64]| {
+            (0..self.rows()).all(|r| slack(x, r) >= -POLISH_TOLERANCE * self.row_width[r])
+        };
         if active.is_empty() {
             // The QP's optimum with no active row is λ = 0 (f = f_p); an LP's stays.
             let zero = vec![0.0; n];
@@ -293,31 +297,6 @@ impl Program {
             .collect();
         if feasible(&polished) { polished } else { x }
     }
-}
-
-/// The solver's settings: quiet, no equilibration (the rows are unit-scaled cable tensions
-/// already), otherwise clarabel's defaults.
-fn settings() -> DefaultSettings<f64> {
-    DefaultSettings { verbose: false, equilibrate_enable: false, ..DefaultSettings::default() }
-}
-
-/// Dense to CSC, skipping exact zeros.
-fn csc(rows: usize, cols: usize, at: impl Fn(usize, usize) -> f64) -> CscMatrix<f64> {
-    let mut colptr = Vec::with_capacity(cols + 1);
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    colptr.push(0);
-    for c in 0..cols {
-        for r in 0..rows {
-            let v = at(r, c);
-            if v != 0.0 {
-                rowval.push(r);
-                nzval.push(v);
-            }
-        }
-        colptr.push(rowval.len());
-    }
-    CscMatrix::new(rows, cols, colptr, rowval, nzval)
 }
 
 /// A certificate `w` (cable weights, in the range of `J_c`) read back as the joint motion
@@ -357,7 +336,7 @@ fn limits_certificate(
             }
             let by = shortfall(&candidate);
             let scale = (0..m).map(|c| upper[c].abs().max(lower[c].abs())).fold(0.0, f64::max);
-            if by > 1e-9 * scale && best.as_ref().is_none_or(|(b, _)| by > *b) {
+            if by > SHORTFALL_TOLERANCE * scale && best.as_ref().is_none_or(|(b, _)| by > *b) {
                 best = Some((by, candidate));
             }
         }
@@ -374,13 +353,13 @@ fn limits_certificate(
         // Rounding noise (~1e-16) in the other joints' components would read as motion.
         direction
             .iter_mut()
-            .for_each(|v| *v = if v.abs() <= 1e-12 * scale { 0.0 } else { *v / scale });
+            .for_each(|v| *v = if v.abs() <= NOISE_TOLERANCE * scale { 0.0 } else { *v / scale });
         w.iter_mut().for_each(|v| *v /= scale);
     }
     let largest = w.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let named = |sign: f64| -> Vec<String> {
         (0..m)
-            .filter(|&c| sign * w[c] >= 0.1 * largest && largest > 0.0)
+            .filter(|&c| sign * w[c] >= NAMED_SHARE * largest && largest > 0.0)
             .map(|c| names.get(c).cloned().unwrap_or_else(|| format!("#{}", c + 1)))
             .collect()
     };
@@ -394,38 +373,4 @@ fn limits_certificate(
             direction,
         },
     }))
-}
-
-/// Whether some strictly positive tension vector lies in `null(J_cᵀ)`: maximise `t` with
-/// `N λ ≥ t`, `|λ_i| ≤ 1`; closure when `t > 1e-9`.
-pub(crate) fn force_closure(set: &EquilibriumSet) -> Result<bool, StaticsError> {
-    let (m, k) = (set.cable_count(), set.dimension());
-    if k == 0 {
-        return Ok(false);
-    }
-    let null = set.null_basis();
-    let n = k + 1;
-    let rows = m + 2 * k;
-    let a = csc(rows, n, |r, c| {
-        if r < m {
-            if c < k { -null[(r, c)] } else { 1.0 }
-        } else if c == (r - m) % k && c < k {
-            if r < m + k { 1.0 } else { -1.0 }
-        } else {
-            0.0
-        }
-    });
-    let mut b = vec![0.0; rows];
-    b[m..].fill(1.0);
-    let mut q = vec![0.0; n];
-    q[k] = -1.0;
-    let settings = settings();
-    let cones = [SupportedConeT::NonnegativeConeT(rows)];
-    let mut solver = DefaultSolver::new(&CscMatrix::zeros((n, n)), &q, &a, &b, &cones, settings)
-        .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
-    solver.solve();
-    match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solver.solution.x[k] > 1e-9),
-        status => Err(StaticsError::Solver { status: format!("{status:?}") }),
-    }
 }
