@@ -32,7 +32,7 @@ use crate::error::{InfeasibleReason, StaticsError};
 pub const FORCE_CLOSURE_TOLERANCE: f64 = 1e-9;
 
 /// `det(J_cᵀ J_c)` below this fraction of `(trace)²` counts as a rank-deficient cable Jacobian.
-pub const RANK_TOLERANCE: f64 = 1e-12;
+pub const JOINT_RANK_TOLERANCE: f64 = 1e-12;
 
 /// Tension limits of a joint's cables, N.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -133,7 +133,7 @@ pub(crate) fn joint_block(jacobian: MatRef<'_, f64>, joint: usize) -> Matrix3x2<
 }
 
 /// `f_p = −J_c (J_cᵀ J_c)⁻¹ τ`: the minimum-norm tensions with `τ + J_cᵀ f_p = 0` (eq. 23),
-/// `None` when the 3 × 2 block has rank < 2 (see [`RANK_TOLERANCE`]).
+/// `None` when the 3 × 2 block has rank < 2 (see [`JOINT_RANK_TOLERANCE`]).
 pub fn minimum_norm_tensions(
     jacobian: &Matrix3x2<f64>,
     tau: &Vector2<f64>,
@@ -142,7 +142,7 @@ pub fn minimum_norm_tensions(
     let det = jtj[(0, 0)] * jtj[(1, 1)] - jtj[(0, 1)] * jtj[(1, 0)];
     let trace = jtj[(0, 0)] + jtj[(1, 1)];
     // Written so that a NaN determinant also counts as rank-deficient.
-    let full_rank = det > RANK_TOLERANCE * trace * trace;
+    let full_rank = det > JOINT_RANK_TOLERANCE * trace * trace;
     if !full_rank {
         return None;
     }

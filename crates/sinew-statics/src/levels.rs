@@ -2,13 +2,13 @@
 //! null-space coordinate (spec §4): the closed form's inverse and derivative, for the
 //! [`ArmStatics`] of a routing with three cables per universal joint.
 
-use nalgebra::{Matrix3x2, Vector2, Vector3, Vector6};
+use nalgebra::{Vector2, Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
 
 use crate::arm::{ArmStatics, ArmStaticsData};
 use crate::error::{InfeasibleReason, StaticsError};
-use crate::interval::{minimum_norm_tensions, tension_interval};
+use crate::interval::{joint_block, minimum_norm_tensions, tension_interval};
 
 impl ArmStatics {
     /// The paper's tension levels of balancing `tensions` (one per joint, in `[0, 1]`): where
@@ -41,7 +41,7 @@ impl ArmStatics {
                     tau[1] += jacobian[(c, 2 * i + 1)] * tensions[c];
                 }
             }
-            let block = Matrix3x2::from_fn(|r, k| jacobian[(3 * i + r, 2 * i + k)]);
+            let block = joint_block(jacobian, i);
             let interval = tension_interval(i, &block, &tau, self.limits())?;
             let own = Vector3::new(tensions[3 * i], tensions[3 * i + 1], tensions[3 * i + 2]);
             let lambda = interval.null.dot(&(own - interval.particular));
@@ -97,7 +97,7 @@ impl ArmStatics {
                 delta_tau[0] += jacobian[(c, 2 * k)] * out[c];
                 delta_tau[1] += jacobian[(c, 2 * k + 1)] * out[c];
             }
-            let block = Matrix3x2::from_fn(|r, col| jacobian[(3 * k + r, 2 * k + col)]);
+            let block = joint_block(jacobian, k);
             let delta = minimum_norm_tensions(&block, &delta_tau).ok_or_else(|| {
                 StaticsError::Infeasible {
                     joint: k,

@@ -23,7 +23,7 @@
 //! Every threshold the crate decides by, one name each (the public ones are re-exported here;
 //! the others are private to the file named):
 //!
-//! - [`RANK_TOLERANCE`] (`1e-12`): a joint's 3 × 2 block of `J_c` has rank < 2 when
+//! - [`JOINT_RANK_TOLERANCE`] (`1e-12`): a joint's 3 × 2 block of `J_c` has rank < 2 when
 //!   `det(J_cᵀ J_c) ≤ 1e-12 (trace)²` (closed form).
 //! - [`FORCE_CLOSURE_TOLERANCE`] (`1e-9`): a component of a joint's unit null direction at most
 //!   this in magnitude counts as zero (closed form); the same margin decides the force-closure
@@ -70,8 +70,8 @@ pub use error::{
     StaticsError, UnsupportedRouting,
 };
 pub use interval::{
-    FORCE_CLOSURE_TOLERANCE, RANK_TOLERANCE, TensionInterval, TensionLimits, minimum_norm_tensions,
-    tension_interval,
+    FORCE_CLOSURE_TOLERANCE, JOINT_RANK_TOLERANCE, TensionInterval, TensionLimits,
+    minimum_norm_tensions, tension_interval,
 };
 pub use joint_end::{
     JointEndData, KwGenerators, equilibrium_torque_derivative, equilibrium_torques,

@@ -10,6 +10,21 @@
 //!   Jacobians as typed outcomes;
 //! - the whole pipeline `Q → K_x` for a robot and its routing: the model [`ArmStiffness`] and
 //!   its workspace [`ArmStiffnessData`].
+//!
+//! The pipeline runs in stages on a workspace ([`ArmStiffness::set_pose`],
+//! [`ArmStiffness::set_tensions`], [`ArmStiffness::solve_end`]; [`ArmStiffness::evaluate`] in
+//! one call), and its one evaluation outcome is [`ArmStiffnessData::outcome`].
+//!
+//! # Tolerances
+//! Every threshold of the crate, named once:
+//! - [`END_RANK_TOLERANCE`] (`1e-10`): a pivot of `C_x`'s 6 × 6 LU below this fraction of the
+//!   largest means `J_x` has rank < 6 ([`has_full_rank`], the one test of it, which the
+//!   planner uses too); the same fraction of the singular values of `C_x[0:3, 0:3]` decides
+//!   that the translational stiffness with rotations free does not exist.
+//! - `RESIDUAL_TOLERANCE` (`structured/mod.rs`, `1e-12`): the backward error above which the
+//!   structured `O(dof)` solve is not trusted and the dense reference runs instead.
+//! - Positive definiteness of `K_q + K_W` has no threshold: a Cholesky pivot that is not
+//!   strictly positive (or NaN) is unstable.
 #![deny(missing_docs)]
 
 mod arm;
