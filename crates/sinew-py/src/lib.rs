@@ -15,6 +15,7 @@ mod errors;
 mod indicators;
 mod lazy;
 mod model;
+mod results;
 
 /// The extension module `sinew._sinew`, re-exported by the `sinew` package.
 #[pymodule]
@@ -23,9 +24,9 @@ fn _sinew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Robot>()?;
     m.add_class::<model::Routing>()?;
     m.add_class::<arm::ArmStiffness>()?;
-    m.add_class::<arm::ArmResult>()?;
-    m.add_class::<arm::BatchResult>()?;
-    m.add_class::<arm::PlanResult>()?;
+    m.add_class::<results::ArmResult>()?;
+    m.add_class::<results::BatchResult>()?;
+    m.add_class::<results::PlanResult>()?;
     m.add_class::<indicators::JointRange>()?;
     m.add_class::<indicators::SweepResult>()?;
     m.add_function(wrap_pyfunction!(model::load_robot, m)?)?;

@@ -25,7 +25,8 @@
 use faer::MatRef;
 use nalgebra::{Matrix3x2, Vector2, Vector3};
 
-use crate::error::{InfeasibleReason, StaticsError};
+use crate::error::StaticsError;
+use crate::refusal::InfeasibleReason;
 
 /// A component of the (unit) null direction below this in magnitude counts as zero: that cable's
 /// tension cannot be changed without losing balance, and the joint is not in force closure.

@@ -7,8 +7,9 @@ use sinew_robot::{Robot, RobotData};
 use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
 
 use crate::arm::{ArmStatics, ArmStaticsData};
-use crate::error::{InfeasibleReason, StaticsError};
+use crate::error::StaticsError;
 use crate::interval::{joint_block, minimum_norm_tensions, tension_interval};
+use crate::refusal::InfeasibleReason;
 
 impl ArmStatics {
     /// The paper's tension levels of balancing `tensions` (one per joint, in `[0, 1]`): where

@@ -53,6 +53,7 @@
 #![deny(missing_docs)]
 
 mod arm;
+mod choice;
 pub mod convex;
 mod distribution;
 mod equilibrium;
@@ -61,14 +62,13 @@ mod interval;
 mod joint_end;
 mod levels;
 mod policy;
+mod refusal;
 
-pub use arm::{ArmStatics, ArmStaticsData, Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
+pub use arm::{ArmStatics, ArmStaticsData};
+pub use choice::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, SET_RANK_TOLERANCE};
-pub use error::{
-    InfeasibleReason, LevelsInfeasible, NoEquilibrium, NoEquilibriumCause, NotBalanced,
-    StaticsError, UnsupportedRouting,
-};
+pub use error::{NoEquilibrium, NoEquilibriumCause, StaticsError, UnsupportedRouting};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, JOINT_RANK_TOLERANCE, TensionInterval, TensionLimits,
     minimum_norm_tensions, tension_interval,
@@ -77,6 +77,7 @@ pub use joint_end::{
     JointEndData, KwGenerators, equilibrium_torque_derivative, equilibrium_torques,
 };
 pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
+pub use refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
 
 use faer::MatRef;
 
