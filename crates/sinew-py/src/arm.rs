@@ -124,10 +124,8 @@ impl ArmStiffness {
                 &mut fresh
             }
         };
-        let end = arm
-            .evaluate_joints(data, &q, &f0, choice)
-            .and_then(|()| arm.solve_end(data))
-            .map_err(library)?;
+        arm.evaluate_joints(data, &q, &f0, choice).map_err(library)?;
+        let end = arm.solve_end(data).map_err(library)?;
         let (stable, full_rank) = (end.is_stable(), end.has_end_stiffness());
         // The ellipsoid's note is added when the ellipsoid is read (`notes`).
         let notes = end.note().iter().map(|n| n.text("None")).collect();

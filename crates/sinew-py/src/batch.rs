@@ -156,7 +156,10 @@ fn row(
         BatchChoice::Default => TensionChoice::Default,
     };
     // The arm refuses angles outside the limits and NaN in its pose stage.
-    let end = match arm.evaluate_joints(data, q, f0, choice).and_then(|()| arm.solve_end(data)) {
+    if let Err(e) = arm.evaluate_joints(data, q, f0, choice) {
+        return fail(out, e.into());
+    }
+    let end = match arm.solve_end(data) {
         Ok(end) => end,
         Err(e) => return fail(out, e.into()),
     };

@@ -66,7 +66,7 @@ impl std::fmt::Display for InfeasibleReason {
     }
 }
 
-/// What is wrong with given tensions ([`StaticsError::NotBalanced`]).
+/// What is wrong with given tensions ([`crate::StaticsError::NotBalanced`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum NotBalanced {
     /// A tension outside its cable's limits (or not finite).
@@ -108,7 +108,7 @@ impl std::fmt::Display for NotBalanced {
     }
 }
 
-/// A refusal of the tension levels that the levels caused ([`StaticsError::LevelsInfeasible`]):
+/// A refusal of the tension levels that the levels caused ([`crate::StaticsError::LevelsInfeasible`]):
 /// in the routed model the closed form fixes the distal joints' tensions first, at their levels,
 /// and those tensions load the proximal joints.
 #[derive(Debug, Clone, PartialEq)]

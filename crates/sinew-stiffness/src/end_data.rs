@@ -130,12 +130,12 @@ impl EndStiffnessData {
         }
     }
 
-    /// `C_x` (6 × 6, m/N, rad/(N m)) from the last [`end_compliance`].
+    /// `C_x` (6 × 6, m/N, rad/(N m)) from the last [`crate::end_compliance`].
     pub fn compliance(&self) -> MatRef<'_, f64> {
         MatRef::from_column_major_slice(&self.c_x, 6, 6)
     }
 
-    /// `K_x` (6 × 6) from the last [`end_stiffness`].
+    /// `K_x` (6 × 6) from the last [`crate::end_stiffness`].
     pub fn stiffness(&self) -> MatRef<'_, f64> {
         MatRef::from_column_major_slice(&self.k_x, 6, 6)
     }
