@@ -144,6 +144,16 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
     ) -> Result<(), StiffnessError> {
         self.check(data)?;
+        self.pose_checked(data, q, f0)
+    }
+
+    /// [`ArmStiffness::set_pose`] on a workspace already checked.
+    fn pose_checked(
+        &self,
+        data: &mut ArmStiffnessData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+    ) -> Result<(), StiffnessError> {
         data.stage = Stage::Empty;
         data.inherent_current = false;
         data.pose_stages += 1;
@@ -184,6 +194,15 @@ impl ArmStiffness {
         choice: TensionChoice<'_>,
     ) -> Result<(), StiffnessError> {
         self.check(data)?;
+        self.tensions_checked(data, choice)
+    }
+
+    /// [`ArmStiffness::set_tensions`] on a workspace already checked.
+    fn tensions_checked(
+        &self,
+        data: &mut ArmStiffnessData,
+        choice: TensionChoice<'_>,
+    ) -> Result<(), StiffnessError> {
         if data.stage == Stage::Empty {
             return Err(StiffnessError::StageMissing { needs: "set_pose", missing: "pose" });
         }
@@ -220,6 +239,11 @@ impl ArmStiffness {
     /// and rank-deficient are outcomes ([`EndOutcome`]), not errors.
     pub fn solve_end(&self, data: &mut ArmStiffnessData) -> Result<EndOutcome, StiffnessError> {
         self.check(data)?;
+        self.end_checked(data)
+    }
+
+    /// [`ArmStiffness::solve_end`] on a workspace already checked.
+    fn end_checked(&self, data: &mut ArmStiffnessData) -> Result<EndOutcome, StiffnessError> {
         match data.stage {
             Stage::Empty | Stage::Posed => {
                 return Err(StiffnessError::StageMissing {
@@ -259,9 +283,11 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         choice: TensionChoice<'_>,
     ) -> Result<(), StiffnessError> {
-        self.set_pose(data, q, f0)?;
-        self.set_tensions(data, choice)?;
-        self.solve_end(data)?.into_result()
+        // The workspace is checked once for the three stages.
+        self.check(data)?;
+        self.pose_checked(data, q, f0)?;
+        self.tensions_checked(data, choice)?;
+        self.end_checked(data)?.into_result()
     }
 
     /// The pipeline up to the joint stiffness in one call: [`ArmStiffness::set_pose`], then
@@ -276,8 +302,9 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         choice: TensionChoice<'_>,
     ) -> Result<(), StiffnessError> {
-        self.set_pose(data, q, f0)?;
-        self.set_tensions(data, choice)
+        self.check(data)?;
+        self.pose_checked(data, q, f0)?;
+        self.tensions_checked(data, choice)
     }
 
     /// `C_x` into `data.end`: the structured solve when it applies and vouches for its result,
