@@ -283,10 +283,8 @@ impl ArmStiffness {
         f0: &Vector6<f64>,
         choice: TensionChoice<'_>,
     ) -> Result<(), StiffnessError> {
-        // The workspace is checked once for the three stages.
-        self.check(data)?;
-        self.pose_checked(data, q, f0)?;
-        self.tensions_checked(data, choice)?;
+        // The workspace is checked once for the three stages (by `evaluate_joints`).
+        self.evaluate_joints(data, q, f0, choice)?;
         self.end_checked(data)?.into_result()
     }
 
