@@ -23,13 +23,21 @@
 #![deny(missing_docs)]
 
 mod bundle;
+mod dense;
 mod error;
+mod frame;
+mod interior;
+mod ipm;
 mod pencil;
 mod phases;
 mod plan;
 mod problem;
 mod rows;
+mod sdp;
+mod smooth;
 
 pub use error::{InputProblem, PlanError};
 pub use plan::{Planner, PlannerData};
-pub use problem::{DEFAULT_GAP, DEFAULT_MARGIN, Objective, Plan, PlanSettings, Requirements};
+pub use problem::{
+    DEFAULT_GAP, DEFAULT_MARGIN, Method, Objective, Plan, PlanSettings, Requirements,
+};

@@ -9,12 +9,14 @@ use nalgebra::Vector6;
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 
-use crate::bundle;
+use crate::bundle::{self, Linear};
 use crate::error::{InputProblem, PlanError};
+use crate::frame::Frame;
+use crate::interior;
 use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
-use crate::problem::{Objective, Plan, PlanSettings, Requirements, check_inputs};
-use crate::rows::{HeldTensions, column_sums, fix_rows, linear_rows};
+use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
+use crate::rows::{HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows};
 
 /// The planner's model: the arm (robot, routing, statics). Immutable; one [`PlannerData`] per
 /// thread.
@@ -27,12 +29,14 @@ pub struct Planner {
 #[derive(Debug)]
 pub struct PlannerData {
     stiffness: ArmStiffnessData,
+    /// The last interior-point answer's multipliers, for a warm start.
+    pub(crate) warm: Option<interior::Warm>,
 }
 
 impl PlannerData {
     /// A workspace for `planner`.
     pub fn new(planner: &Planner) -> PlannerData {
-        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm) }
+        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), warm: None }
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
@@ -89,18 +93,66 @@ impl Planner {
         arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
         let least_total: f64 = sd.tensions().iter().sum();
         let set = arm.equilibrium_set(sd)?.clone();
-        let least_total_lambda = set.coordinates(sd.tensions());
         if let Some(budget) = requirements.budget
             && least_total > budget * (1.0 + 1e-12)
         {
             return Err(PlanError::BudgetTooSmall { budget, least: least_total });
         }
         let pencil = self.pencil(sd, &set)?;
-        let k = set.dimension();
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
-        fix_rows(&set, &fixed, &mut linear);
-        let linear = linear.merged();
+        let (lambda, upper, iterations) = match settings.method {
+            Method::InteriorPoint => {
+                let held = held_coordinates(&set, &fixed);
+                let frame = Frame::new(&pencil, &set, &linear.merged(), &held);
+                let (answer, before) = interior::cold(&frame, objective, requirements, settings)?;
+                data.warm = Some(interior::Warm { duals: answer.duals, objective });
+                (frame.lambda(&answer.x), answer.upper, before + answer.iterations)
+            }
+            Method::Bundle => {
+                fix_rows(&set, &fixed, &mut linear);
+                let linear = linear.merged();
+                let sd = &mut data.stiffness;
+                self.bundle(
+                    sd,
+                    &set,
+                    &pencil,
+                    &linear,
+                    objective,
+                    requirements,
+                    settings,
+                    least_total,
+                )?
+            }
+        };
+        self.answer(
+            &mut data.stiffness,
+            &set,
+            &pencil,
+            objective,
+            requirements,
+            &lambda,
+            upper,
+            iterations,
+        )
+    }
+
+    /// The bundle method's phases from the safest (or least-total) start: `(λ, UB, iterations)`.
+    #[allow(clippy::too_many_arguments)]
+    fn bundle(
+        &self,
+        sd: &mut ArmStiffnessData,
+        set: &EquilibriumSet,
+        pencil: &Pencil,
+        linear: &Linear,
+        objective: Objective,
+        requirements: &Requirements,
+        settings: &PlanSettings,
+        least_total: f64,
+    ) -> Result<(Vec<f64>, f64, usize), PlanError> {
+        let arm = &self.arm;
+        let k = set.dimension();
+        let least_total_lambda = set.coordinates(sd.tensions());
         // A start inside the limits (and the budget): the safest tensions when within the
         // budget, else the least-total ones.
         arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::Safest))?;
@@ -114,28 +166,44 @@ impl Planner {
         let start = if linear.satisfied(&start) {
             start
         } else {
-            bundle::feasible_point(k, &linear)?.ok_or(PlanError::BudgetsInfeasible)?
+            bundle::feasible_point(k, linear)?.ok_or(PlanError::BudgetsInfeasible)?
         };
         let problem = Problem {
-            pencil: &pencil,
+            pencil,
             objective,
             requirements,
             settings,
-            linear: &linear,
+            linear,
             // Σ f = Σ f_p + (Nᵀ 1)ᵀ λ: its constant and gradient, once per plan.
             total: set.particular().iter().sum(),
-            sums: column_sums(&set),
+            sums: column_sums(set),
             // K_des was checked symmetric positive definite.
             k_des_scale: requirements.k_des.and_then(|k| k.cholesky()).map(|c| c.l()),
-            scale: pencil_scale(&pencil),
+            scale: pencil_scale(pencil),
         };
         let (start, stable_iterations) = problem.stable_start(start, k)?;
         let (start, floor_iterations) = problem.floors_start(start)?;
-        let (lambda, value, upper, last_iterations) = problem.optimise(&start, least_total)?;
-        let iterations = stable_iterations + floor_iterations + last_iterations;
-        // The answer, evaluated by the pipeline itself at its tensions (no new pose stage).
+        let (lambda, _, upper, last_iterations) = problem.optimise(&start, least_total)?;
+        Ok((lambda, upper, stable_iterations + floor_iterations + last_iterations))
+    }
+
+    /// The plan at `λ`, evaluated by the pipeline itself at its tensions (no new pose stage),
+    /// with the gap to the bound `upper` of the maximised objective.
+    #[allow(clippy::too_many_arguments)]
+    fn answer(
+        &self,
+        sd: &mut ArmStiffnessData,
+        set: &EquilibriumSet,
+        pencil: &Pencil,
+        objective: Objective,
+        requirements: &Requirements,
+        lambda: &[f64],
+        upper: f64,
+        iterations: usize,
+    ) -> Result<Plan, PlanError> {
+        let arm = &self.arm;
         let mut tensions = vec![0.0; set.cable_count()];
-        set.tensions(&lambda, &mut tensions)?;
+        set.tensions(lambda, &mut tensions)?;
         for (f, (lo, hi)) in tensions.iter_mut().zip(set.lower().iter().zip(set.upper())) {
             *f = f.clamp(*lo, *hi);
         }
@@ -143,23 +211,39 @@ impl Planner {
         arm.solve_end(sd)?;
         let outcome = sd.outcome().ok_or(PlanError::NoEndStiffness)?;
         let min_eigenvalue = outcome.margin()?;
-        let end = pencil.end(&lambda).ok_or(PlanError::NoStableTensions {
+        let no_stable = || PlanError::NoStableTensions {
             margin: requirements.margin,
             best: min_eigenvalue,
             budget: requirements.budget.is_some(),
-        })?;
-        let (value, gap) = match objective {
-            Objective::ComplianceAlong(_) => (-value, upper - value),
-            Objective::LeastTension => (-value, upper - value),
-            _ => (value, upper - value),
+        };
+        let end = pencil.end(lambda).ok_or_else(no_stable)?;
+        let total: f64 = tensions.iter().sum();
+        // The objective in its maximised sense at the answer.
+        let maximised = match objective {
+            Objective::StiffnessAlong(u) => {
+                let w = Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0);
+                end.stiffness_form(pencil, &w).ok_or(PlanError::NoEndStiffness)?.0
+            }
+            Objective::ComplianceAlong(u) => end.compliance_form(pencil, &u).0,
+            Objective::MinStiffness => {
+                end.least_stiffness(pencil, None).ok_or(PlanError::NoEndStiffness)?.0
+            }
+            Objective::Volume => end.log_volume(pencil).ok_or(PlanError::NoEndStiffness)?.0,
+            Objective::LeastTension => -total,
+        };
+        // The bound's own rounding: a few ulps of the value.
+        let gap = (upper - maximised).max(0.0) + 8.0 * f64::EPSILON * maximised.abs();
+        let value = match objective {
+            Objective::ComplianceAlong(_) | Objective::LeastTension => -maximised,
+            _ => maximised,
         };
         let levels = arm.statics().levels_of(&sd.cables, &sd.statics, &tensions).ok();
         Ok(Plan {
             objective,
             value,
-            gap: gap.max(0.0),
-            total_tension: tensions.iter().sum(),
-            lambda,
+            gap,
+            total_tension: total,
+            lambda: lambda.to_vec(),
             tensions,
             levels,
             k_fd: end.k_fd(),

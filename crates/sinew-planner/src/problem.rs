@@ -76,6 +76,18 @@ pub const DEFAULT_MARGIN: f64 = 1e-3;
 /// The default relative gap at which a plan stops.
 pub const DEFAULT_GAP: f64 = 1e-6;
 
+/// The method of a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// The primal–dual interior-point method on the plan's matrix inequalities (`sdp.rs`,
+    /// `ipm.rs`): the default.
+    #[default]
+    InteriorPoint,
+    /// The level bundle method on clarabel LPs and QPs (`bundle.rs`): a second, independent
+    /// method for tests and benchmarks.
+    Bundle,
+}
+
 /// How a plan stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanSettings {
@@ -83,11 +95,13 @@ pub struct PlanSettings {
     pub relative_gap: f64,
     /// Give up (with [`PlanError::NotConverged`]) after this many iterations.
     pub max_iterations: usize,
+    /// The method.
+    pub method: Method,
 }
 
 impl Default for PlanSettings {
     fn default() -> Self {
-        PlanSettings { relative_gap: DEFAULT_GAP, max_iterations: 2000 }
+        PlanSettings { relative_gap: DEFAULT_GAP, max_iterations: 2000, method: Method::default() }
     }
 }
 

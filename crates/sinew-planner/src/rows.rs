@@ -43,23 +43,35 @@ pub(crate) fn linear_rows(
 /// A joint held at a level: its cables and their tensions there.
 pub(crate) type HeldTensions = (std::ops::Range<usize>, Vec<f64>);
 
-/// Hold each fixed joint's own tensions: its null coordinate (the one column of `N` on its
-/// cables, decoupled) fixed to the value that gives them, as two rows a rounding apart.
+/// Each held joint's null coordinate (the one column of `N` on its cables, decoupled) and the
+/// value that gives its tensions: `(coordinate, value)`.
+pub(crate) fn held_coordinates(
+    set: &EquilibriumSet,
+    fixed: &[(std::ops::Range<usize>, Vec<f64>)],
+) -> Vec<(usize, f64)> {
+    let null = set.null_basis();
+    let k = set.dimension();
+    let p = set.particular();
+    fixed
+        .iter()
+        .filter_map(|(cables, target)| {
+            let column = (0..k).find(|&i| cables.clone().any(|c| null[(c, i)].abs() > 0.5))?;
+            let value =
+                cables.clone().zip(target).map(|(c, t)| null[(c, column)] * (t - p[c])).sum();
+            Some((column, value))
+        })
+        .collect()
+}
+
+/// Hold each fixed joint's own tensions ([`held_coordinates`]) as two rows a rounding apart
+/// (the bundle method's form; the interior-point method removes the coordinate instead).
 pub(crate) fn fix_rows(
     set: &EquilibriumSet,
     fixed: &[(std::ops::Range<usize>, Vec<f64>)],
     linear: &mut Linear,
 ) {
-    let null = set.null_basis();
     let k = set.dimension();
-    let p = set.particular();
-    for (cables, target) in fixed {
-        let Some(column) = (0..k).find(|&i| cables.clone().any(|c| null[(c, i)].abs() > 0.5))
-        else {
-            continue;
-        };
-        let value: f64 =
-            cables.clone().zip(target).map(|(c, t)| null[(c, column)] * (t - p[c])).sum();
+    for (column, value) in held_coordinates(set, fixed) {
         let tol = 1e-9 * (1.0 + value.abs());
         let mut up = vec![0.0; k];
         up[column] = 1.0;

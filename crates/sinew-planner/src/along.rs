@@ -1,0 +1,48 @@
+//! Re-planning along a trajectory: one plan per step, each warm-started from the previous
+//! step's answer, optionally with a bound on each cable's rate of tension change.
+//!
+//! # Warm start
+//! The previous tensions are mapped into the new pose's equilibrium set through the tensions,
+//! `λ' = N'ᵀ(f_prev − f_p')`, so a change of basis of `N` does not matter. When that point is
+//! strictly inside the new constraints (else it is pulled towards the new pose's stable point by
+//! the least fraction that makes it so: the restoration step), the last phase runs from it with
+//! multipliers centred there (`μ` by least squares) and a small iteration cap. Its answer is
+//! accepted only with its certificate within the tolerance; otherwise the step runs cold.
+
+use nalgebra::Vector6;
+
+/// One step of a trajectory: the pose and the end's force (base frame, no moment).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// The joint angles, rad.
+    pub q: Vec<f64>,
+    /// The wrench at the end (its moment must be zero), N.
+    pub f0: Vector6<f64>,
+}
+
+/// A bound on the rate of tension change: `|f_k − f_{k−1}| ≤ max_rate · dt` per cable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RateLimit {
+    /// The largest rate of change of any cable's tension, N/s.
+    pub max_rate: f64,
+    /// The time step between two steps, s.
+    pub dt: f64,
+}
+
+impl RateLimit {
+    /// The largest change per step, N.
+    pub fn max_change(&self) -> f64 {
+        self.max_rate * self.dt
+    }
+}
+
+/// What one step of [`crate::Planner::plan_along`] gave.
+#[derive(Debug)]
+pub struct AlongStep {
+    /// The plan, or why the step has none (the next step then starts cold).
+    pub plan: Result<crate::Plan, crate::PlanError>,
+    /// Whether the warm path's answer was accepted (certified within the tolerance).
+    pub warm: bool,
+    /// Iterations of the method at this step (the warm attempt's included).
+    pub iterations: usize,
+}
