@@ -8,9 +8,11 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Vector3, Vector6};
-use sinew_planner::{Objective, PlanSettings, Planner, PlannerData, Requirements};
+use sinew_planner::{Method, Objective, PlanSettings, Planner, PlannerData, Requirements};
 use sinew_routing::PatternModel;
+use sinew_statics::TensionChoice;
 use sinew_stiffness::ArmStiffness;
+use sinew_stiffness::ArmStiffnessData;
 use sinew_testkit::cdhrm5;
 
 fn objectives() -> [Objective; 5] {
@@ -23,29 +25,53 @@ fn objectives() -> [Objective; 5] {
     ]
 }
 
+/// Each case's plan by both methods, and one pipeline evaluation of the same arm, in one run:
+/// the ratio plan / evaluation is what stays meaningful on another machine.
 fn bench_plans(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
     group.sample_size(20);
-    let settings = PlanSettings::default();
     let requirements = Requirements::default();
+    let methods = [(Method::InteriorPoint, "ipm"), (Method::Bundle, "bundle")];
     for model in cdhrm5::MODELS {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
-        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let planner = Planner::new(arm.clone());
         let mut data = PlannerData::new(&planner);
         let q = cdhrm5::LOADED_POSE;
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
         let name = if model == PatternModel::Decoupled { "decoupled" } else { "routed" };
+        let mut sd = ArmStiffnessData::new(&arm);
+        let levels = [0.5; 5];
+        group.bench_function(format!("cdhrm5 {name} one evaluation"), |b| {
+            b.iter(|| arm.evaluate(&mut sd, black_box(&q), &f0, TensionChoice::Levels(&levels)))
+        });
         for objective in objectives() {
-            let plan =
-                planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
-            println!("cdhrm5 {name} {}: {} iterations", objective.name(), plan.iterations);
-            group.bench_function(format!("cdhrm5 {name} {}", objective.name()), |b| {
-                b.iter(|| {
-                    planner
-                        .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
-                        .unwrap()
-                })
-            });
+            for (method, label) in methods {
+                let settings = PlanSettings { method, ..PlanSettings::default() };
+                let plan =
+                    planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+                println!(
+                    "cdhrm5 {name} {} {label}: {} iterations, value {:.9e}, gap {:.1e}",
+                    objective.name(),
+                    plan.iterations,
+                    plan.value,
+                    plan.gap
+                );
+                group.bench_function(format!("cdhrm5 {name} {} {label}", objective.name()), |b| {
+                    b.iter(|| {
+                        planner
+                            .plan(
+                                &mut data,
+                                black_box(&q),
+                                &f0,
+                                objective,
+                                &requirements,
+                                &settings,
+                            )
+                            .unwrap()
+                    })
+                });
+            }
         }
     }
     let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
@@ -56,15 +82,25 @@ fn bench_plans(c: &mut Criterion) {
     let f0 = Vector6::new(0.0, 0.02, 0.01, 0.0, 0.0, 0.0);
     group.sample_size(10);
     for objective in [Objective::StiffnessAlong(Vector3::y()), Objective::MinStiffness] {
-        let plan = planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
-        println!("chain 25 decoupled {}: {} iterations", objective.name(), plan.iterations);
-        group.bench_function(format!("chain 25 decoupled {}", objective.name()), |b| {
-            b.iter(|| {
-                planner
-                    .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
-                    .unwrap()
-            })
-        });
+        for (method, label) in methods {
+            let settings = PlanSettings { method, ..PlanSettings::default() };
+            let plan =
+                planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+            println!(
+                "chain 25 decoupled {} {label}: {} iterations, value {:.9e}, gap {:.1e}",
+                objective.name(),
+                plan.iterations,
+                plan.value,
+                plan.gap
+            );
+            group.bench_function(format!("chain 25 decoupled {} {label}", objective.name()), |b| {
+                b.iter(|| {
+                    planner
+                        .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
+                        .unwrap()
+                })
+            });
+        }
     }
     group.finish();
 }

@@ -46,3 +46,47 @@ pub struct AlongStep {
     /// Iterations of the method at this step (the warm attempt's included).
     pub iterations: usize,
 }
+
+impl crate::Planner {
+    /// Plans along a trajectory: one certified plan per step, each warm-started from the
+    /// previous step's answer (module docs), with `rate` bounding every cable's change per step.
+    /// A step without a plan is typed in its row ([`AlongStep::plan`]); the next starts cold.
+    ///
+    /// # Errors
+    /// [`crate::PlanError::InvalidInput`] for a rate or time step that is not finite and
+    /// positive (then no step is planned).
+    pub fn plan_along(
+        &self,
+        data: &mut crate::PlannerData,
+        steps: &[Step],
+        objective: crate::Objective,
+        requirements: &crate::Requirements,
+        settings: &crate::PlanSettings,
+        rate: Option<RateLimit>,
+    ) -> Result<Vec<AlongStep>, crate::PlanError> {
+        use crate::{InputProblem, PlanError};
+        if let Some(r) = rate {
+            for (what, v) in [("max_rate", r.max_rate), ("dt", r.dt)] {
+                if !(v.is_finite() && v > 0.0) {
+                    let problem = InputProblem::NotPositive { unit: "", reason: "" };
+                    return Err(PlanError::InvalidInput { what, problem });
+                }
+            }
+        }
+        data.previous = None;
+        let change = rate.map(|r| r.max_change());
+        let mut out = Vec::with_capacity(steps.len());
+        for step in steps {
+            let result =
+                self.plan_step(data, &step.q, &step.f0, objective, requirements, settings, change);
+            out.push(match result {
+                Ok((plan, warm, iterations)) => AlongStep { plan: Ok(plan), warm, iterations },
+                Err(e) => {
+                    data.previous = None;
+                    AlongStep { plan: Err(e), warm: false, iterations: 0 }
+                }
+            });
+        }
+        Ok(out)
+    }
+}

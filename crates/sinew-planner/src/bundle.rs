@@ -144,6 +144,7 @@ pub(crate) fn maximise(
     let mut constraint_cuts: Vec<(Cut, f64)> = Vec::new();
     let mut best: Option<(Vec<f64>, f64)> = None;
     let mut centre = start.to_vec();
+    let mut last_bound: Option<(f64, Vec<f64>)> = None;
     let first = evaluate(start)?;
     record(&first, start, linear, &mut objective_cuts, &mut constraint_cuts, &mut best);
     for iteration in 1..=settings.max_iterations {
@@ -152,10 +153,16 @@ pub(crate) fn maximise(
         {
             return Ok(Outcome::Reached { lambda: lambda.clone(), iterations: iteration - 1 });
         }
-        let Some((upper, upper_point)) = upper_bound(k, &objective_cuts, &constraint_cuts, linear)?
-        else {
+        // A bound LP solved only to reduced accuracy: the last bound still holds (cuts only
+        // add), and the step goes on from the level set.
+        let bound = match upper_bound(k, &objective_cuts, &constraint_cuts, linear) {
+            Err(PlanError::Solver { .. }) if last_bound.is_some() => last_bound.clone(),
+            bound => bound?,
+        };
+        let Some((upper, upper_point)) = bound else {
             return Ok(Outcome::Infeasible);
         };
+        last_bound = Some((upper, upper_point.clone()));
         if let Some(target) = settings.target
             && upper < target
         {
@@ -164,6 +171,11 @@ pub(crate) fn maximise(
         let next = match &best {
             Some((lambda, value)) => {
                 let gap = upper - value;
+                if gap < -1e-9 * value.abs().max(settings.scale) {
+                    // A bound below a feasible value: the LP's answer is not to be trusted.
+                    let status = format!("LP bound {upper:e} below a feasible value {value:e}");
+                    return Err(PlanError::Solver { status });
+                }
                 if gap <= settings.relative_gap * value.abs().max(settings.scale) {
                     return Ok(Outcome::Optimum {
                         lambda: lambda.clone(),
@@ -300,8 +312,26 @@ fn solve(
 ) -> Result<Option<Vec<f64>>, PlanError> {
     let p = if quadratic { CscMatrix::identity(n) } else { CscMatrix::zeros((n, n)) };
     let m = rows.len();
-    let a = dense_csc(m, n, |r, c| rows[r].0[c]);
-    let b: Vec<f64> = rows.iter().map(|(_, b)| *b).collect();
+    // The LP equilibrated (x = D x̃, each column and then each row of A D scaled to a largest
+    // entry of 1): its cuts mix λ ~ 10³ N with gradients ~ 10⁻⁵, and unscaled, clarabel's
+    // answer can fall below a feasible value by 10⁻⁴ relative. The QP keeps its metric.
+    let column_scale: Vec<f64> = (0..n)
+        .map(|c| {
+            let largest = rows.iter().fold(0.0_f64, |a, (r, _)| a.max(r[c].abs()));
+            if quadratic || largest == 0.0 { 1.0 } else { 1.0 / largest }
+        })
+        .collect();
+    let row_scale: Vec<f64> = rows
+        .iter()
+        .map(|(r, _)| {
+            let largest =
+                r.iter().zip(&column_scale).fold(0.0_f64, |a, (v, d)| a.max((v * d).abs()));
+            if quadratic || largest == 0.0 { 1.0 } else { 1.0 / largest }
+        })
+        .collect();
+    let a = dense_csc(m, n, |r, c| rows[r].0[c] * column_scale[c] * row_scale[r]);
+    let b: Vec<f64> = rows.iter().zip(&row_scale).map(|((_, b), s)| b * s).collect();
+    let q: Vec<f64> = q.iter().zip(&column_scale).map(|(v, d)| v * d).collect();
     let cones = [SupportedConeT::NonnegativeConeT(m)];
     let settings = DefaultSettings {
         verbose: false,
@@ -310,11 +340,17 @@ fn solve(
         tol_feas: 1e-10,
         ..DefaultSettings::default()
     };
-    let mut solver = DefaultSolver::new(&p, q, &a, &b, &cones, settings)
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
         .map_err(|e| PlanError::Solver { status: format!("setup: {e}") })?;
     solver.solve();
     match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(Some(solver.solution.x.clone())),
+        // An LP answer only to reduced accuracy is no bound (its value can be 10⁻³ low).
+        SolverStatus::AlmostSolved if !quadratic => {
+            Err(PlanError::Solver { status: "AlmostSolved".into() })
+        }
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            Ok(Some(solver.solution.x.iter().zip(&column_scale).map(|(x, d)| x * d).collect()))
+        }
         SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Ok(None),
         status => Err(PlanError::Solver { status: format!("{status:?}") }),
     }

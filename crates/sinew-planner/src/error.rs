@@ -53,6 +53,12 @@ pub enum PlanError {
     /// No tensions within the limits meet the per-joint budgets (and the total budget).
     #[error("no tensions within the limits that balance the load meet the per-joint budgets")]
     BudgetsInfeasible,
+    /// Along a trajectory, no tensions within the limits (and the budgets) that balance the
+    /// load are within the rate limit of the previous step's tensions.
+    #[error(
+        "no tensions that balance the load within the limits are within the rate limit of the previous step's tensions: raise the rate or shorten the step"
+    )]
+    RateLimitInfeasible,
     /// The required stiffness cannot be reached within the constraints.
     #[error(
         "the required {what} {} exceeds the best reachable, at most {} (the tension limits, budget and margin allow no more)",
@@ -113,7 +119,8 @@ impl PlanError {
             PlanError::NoStableTensions { .. }
             | PlanError::RequirementUnreachable { .. }
             | PlanError::BudgetTooSmall { .. }
-            | PlanError::BudgetsInfeasible => ErrorKind::Infeasible,
+            | PlanError::BudgetsInfeasible
+            | PlanError::RateLimitInfeasible => ErrorKind::Infeasible,
             PlanError::NoEndStiffness => ErrorKind::RankDeficient,
             PlanError::NonConservativeLoad { .. } | PlanError::InvalidInput { .. } => {
                 ErrorKind::Input

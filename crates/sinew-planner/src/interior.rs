@@ -1,18 +1,14 @@
 //! The interior-point plan, cold: a point inside the rows, a stable one, one meeting the
-//! floors, then the objective ([`crate::ipm`]); and the state a warm start keeps.
+//! floors, then the objective ([`crate::ipm`]); and warm, from the previous step's tensions
+//! mapped into this pose's set (module docs of `along.rs`).
 
 use crate::error::PlanError;
 use crate::frame::Frame;
 use crate::ipm::{Answer, Interior};
 use crate::problem::{Objective, PlanSettings, Requirements};
-use crate::sdp::Duals;
 
-/// What the workspace keeps of the last interior-point answer for the next plan.
-#[derive(Debug, Clone)]
-pub(crate) struct Warm {
-    pub(crate) duals: Duals,
-    pub(crate) objective: Objective,
-}
+/// The most iterations a warm start may take before the step runs cold.
+pub(crate) const WARM_ITERATIONS: usize = 12;
 
 /// The cold method: the answer and the iterations of the phases before the last.
 ///
@@ -30,4 +26,24 @@ pub(crate) fn cold(
     let (x, floors) = problem.floors_met(x)?;
     let answer = problem.optimise(&x, None, settings.max_iterations)?;
     Ok((answer, rows + stable + floors))
+}
+
+/// The last phase from the mapped previous answer `x` (restored into the interior when it
+/// is not strictly inside), capped at [`WARM_ITERATIONS`]: the answer, or the iterations spent
+/// when it is refused (not restorable, not certified in time).
+pub(crate) fn warm(
+    frame: &Frame,
+    objective: Objective,
+    requirements: &Requirements,
+    settings: &PlanSettings,
+    x: Vec<f64>,
+) -> Result<Answer, usize> {
+    let mut problem = Interior::new(frame, objective, requirements, settings);
+    problem.warm = true;
+    let x = problem.restored(x).ok_or(0_usize)?;
+    match problem.optimise(&x, None, WARM_ITERATIONS) {
+        Ok(answer) => Ok(answer),
+        Err(PlanError::NotConverged { iterations, .. }) => Err(iterations),
+        Err(_) => Err(WARM_ITERATIONS),
+    }
 }

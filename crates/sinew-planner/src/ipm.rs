@@ -14,17 +14,16 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector6};
 
+use crate::blocks::{Floor, base, compliance_block, floor_block, margin_block};
 use crate::error::PlanError;
-use crate::frame::{Frame, congruence};
+use crate::frame::Frame;
 use crate::problem::{Objective, PlanSettings, Requirements};
-use crate::sdp::{self, Block, Duals, End, Run, Sdp, Settings};
+use crate::sdp::{self, Block, Duals, End, Run, Settings};
 use crate::smooth::{EndObjective, Kind};
 
-/// The floor a phase or a requirement puts on `K_fd`: `K_fd ⪰ τ K`.
-#[derive(Debug, Clone, Copy)]
-struct Floor {
-    k: Matrix3<f64>,
-}
+/// How far past its target a feasibility phase goes, as a fraction of the bound's excess: a
+/// start well inside the margin and the floors, not on their boundary.
+const CENTRING: f64 = 0.3;
 
 /// One plan's interior-point problem.
 pub(crate) struct Interior<'a> {
@@ -34,6 +33,8 @@ pub(crate) struct Interior<'a> {
     pub(crate) settings: &'a PlanSettings,
     /// `R` (n × (n − 3)), when `J_r` has rank 3.
     pub(crate) rotation_null: Option<Vec<f64>>,
+    /// A warm start: epigraph variables start just inside their block, not halfway.
+    pub(crate) warm: bool,
 }
 
 /// The answer of the last phase in the frame's coordinates, with the real-unit bound.
@@ -59,6 +60,7 @@ impl<'a> Interior<'a> {
             requirements,
             settings,
             rotation_null: frame.rotation_null_basis(),
+            warm: false,
         }
     }
 
@@ -68,126 +70,6 @@ impl<'a> Interior<'a> {
             best,
             budget: self.requirements.budget.is_some(),
         }
-    }
-
-    /// The base problem: the rows (with `extra` zero columns) and the box, no block.
-    fn base(&self, extra: usize) -> Sdp {
-        let f = self.frame;
-        let k = f.vars();
-        let width = k + extra;
-        let mut rows = Vec::with_capacity(f.rhs.len() * width);
-        for r in 0..f.rhs.len() {
-            rows.extend_from_slice(&f.rows[r * k..r * k + k]);
-            rows.extend(std::iter::repeat_n(0.0, extra));
-        }
-        let mut lo = vec![-1.0; width];
-        let mut hi = vec![1.0; width];
-        for e in k..width {
-            lo[e] = f64::NEG_INFINITY;
-            hi[e] = f64::INFINITY;
-        }
-        Sdp {
-            c0: 0.0,
-            c: vec![0.0; width],
-            rows,
-            rhs: f.rhs.clone(),
-            blocks: Vec::new(),
-            lo,
-            hi,
-            epigraph: None,
-        }
-    }
-
-    /// `(A(x) − shift I)/a_scale`, with `−(t_scale/a_scale) I` for an epigraph variable.
-    fn margin_block(&self, shift: f64, extra: usize, epigraph: Option<f64>) -> Block {
-        let f = self.frame;
-        let n = f.n;
-        let s = 1.0 / f.a_scale;
-        let mut constant: Vec<f64> = f.a0.iter().map(|v| v * s).collect();
-        for i in 0..n {
-            constant[i * n + i] -= shift * s;
-        }
-        let mut coefficients: Vec<Option<Vec<f64>>> =
-            f.ai.iter().map(|a| Some(a.iter().map(|v| v * s).collect())).collect();
-        coefficients.extend(std::iter::repeat_n(None, extra));
-        if let Some(t_scale) = epigraph {
-            let mut d = vec![0.0; n * n];
-            for i in 0..n {
-                d[i * n + i] = -t_scale * s;
-            }
-            coefficients[f.vars()] = Some(d);
-        }
-        Block { n, constant, coefficients }
-    }
-
-    /// `Rᵀ(A − τ J_pᵀ K J_p)R / scale`, with `τ` fixed or `τ = t_scale · t`.
-    fn floor_block(&self, floor: Floor, tau: Result<f64, f64>, extra: usize) -> Option<Block> {
-        let f = self.frame;
-        let r = self.rotation_null.as_ref()?;
-        let (n, p) = (f.n, f.n - 3);
-        // Q = J_pᵀ K J_p (n × n).
-        let mut q = vec![0.0; n * n];
-        for a in 0..n {
-            for b in 0..n {
-                let mut v = 0.0;
-                for i in 0..3 {
-                    for j in 0..3 {
-                        v += f.j_x[i * n + a] * floor.k[(i, j)] * f.j_x[j * n + b];
-                    }
-                }
-                q[a * n + b] = v;
-            }
-        }
-        let d = congruence(&q, r, n, p);
-        let b0 = congruence(&f.a0, r, n, p);
-        let scale = (0..p).map(|i| b0[i * p + i].abs()).fold(0.0, f64::max).max(1e-300);
-        let s = 1.0 / scale;
-        let fixed = tau.unwrap_or(0.0);
-        let constant: Vec<f64> = b0.iter().zip(&d).map(|(b, dd)| (b - fixed * dd) * s).collect();
-        let mut coefficients: Vec<Option<Vec<f64>>> =
-            f.ai.iter()
-                .map(|a| Some(congruence(a, r, n, p).iter().map(|v| v * s).collect()))
-                .collect();
-        coefficients.extend(std::iter::repeat_n(None, extra));
-        if let Err(t_scale) = tau {
-            coefficients[f.vars()] = Some(d.iter().map(|v| -t_scale * v * s).collect());
-        }
-        Some(Block { n: p, constant, coefficients })
-    }
-
-    /// `[[A, J_pᵀu], [uᵀJ_p, s]]` congruence-scaled by `diag(a_scale^{-1/2} I, s_scale^{-1/2})`,
-    /// `s = s_scale · t`.
-    fn compliance_block(&self, u: &nalgebra::Vector3<f64>, s_scale: f64) -> Block {
-        let f = self.frame;
-        let n = f.n;
-        let m = n + 1;
-        let sa = 1.0 / f.a_scale;
-        let cross = 1.0 / (f.a_scale * s_scale).sqrt();
-        let mut constant = vec![0.0; m * m];
-        for r in 0..n {
-            for c in 0..n {
-                constant[r * m + c] = f.a0[r * n + c] * sa;
-            }
-            let b: f64 = (0..3).map(|i| f.j_x[i * n + r] * u[i]).sum();
-            constant[r * m + n] = b * cross;
-            constant[n * m + r] = b * cross;
-        }
-        let mut coefficients: Vec<Option<Vec<f64>>> =
-            f.ai.iter()
-                .map(|a| {
-                    let mut e = vec![0.0; m * m];
-                    for r in 0..n {
-                        for c in 0..n {
-                            e[r * m + c] = a[r * n + c] * sa;
-                        }
-                    }
-                    Some(e)
-                })
-                .collect();
-        let mut d = vec![0.0; m * m];
-        d[n * m + n] = 1.0;
-        coefficients.push(Some(d));
-        Block { n: m, constant, coefficients }
     }
 
     /// `λ_min(A(x))`, N m/rad (one symmetric eigensolve, outside the iterations).
@@ -204,7 +86,13 @@ impl<'a> Interior<'a> {
     }
 
     fn settings(&self, target: Option<f64>, relative_gap: f64, scale: f64) -> Settings {
-        Settings { relative_gap, scale, max_iterations: self.settings.max_iterations, target }
+        Settings {
+            relative_gap,
+            scale,
+            max_iterations: self.settings.max_iterations,
+            target,
+            centring: CENTRING,
+        }
     }
 
     /// Phase 0: a point strictly inside the rows, near their Chebyshev centre.
@@ -220,7 +108,7 @@ impl<'a> Interior<'a> {
             return Ok((x0, 0));
         }
         // max τ s.t. G x + τ 1 ≤ h, τ ≤ 1; τ's box [τ₀ − 1, 1] holds the optimum.
-        let mut sdp = self.base(1);
+        let mut sdp = base(self.frame, 1);
         for r in 0..f.rhs.len() {
             sdp.rows[r * (k + 1) + k] = 1.0;
         }
@@ -257,8 +145,8 @@ impl<'a> Interior<'a> {
             return Ok((x, 0));
         }
         let k = f.vars();
-        let mut sdp = self.base(1);
-        sdp.blocks.push(self.margin_block(0.0, 1, Some(f.a_scale)));
+        let mut sdp = base(self.frame, 1);
+        sdp.blocks.push(margin_block(self.frame, 0.0, 1, Some(f.a_scale)));
         sdp.c[k] = 1.0;
         sdp.epigraph = Some((k, 0));
         let mut start = x;
@@ -290,9 +178,12 @@ impl<'a> Interior<'a> {
 
     /// The margin and the floors met so far as fixed blocks, with `extra` columns.
     fn constraint_blocks(&self, floors: usize, extra: usize) -> Result<Vec<Block>, PlanError> {
-        let mut blocks = vec![self.margin_block(self.requirements.margin, extra, None)];
+        let mut blocks = vec![margin_block(self.frame, self.requirements.margin, extra, None)];
         for (floor, tau, _) in self.floors().into_iter().take(floors) {
-            blocks.push(self.floor_block(floor, Ok(tau), extra).ok_or(PlanError::NoEndStiffness)?);
+            blocks.push(
+                floor_block(self.frame, self.rotation_null.as_ref(), floor, Ok(tau), extra)
+                    .ok_or(PlanError::NoEndStiffness)?,
+            );
         }
         Ok(blocks)
     }
@@ -320,10 +211,11 @@ impl<'a> Interior<'a> {
                 continue;
             }
             let scale = now.abs().max(tau.abs()).max(1e-12);
-            let mut sdp = self.base(1);
+            let mut sdp = base(self.frame, 1);
             sdp.blocks = self.constraint_blocks(index, 1)?;
             let epigraph =
-                self.floor_block(floor, Err(scale), 1).ok_or(PlanError::NoEndStiffness)?;
+                floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
+                    .ok_or(PlanError::NoEndStiffness)?;
             sdp.blocks.push(epigraph);
             sdp.c[k] = 1.0;
             sdp.epigraph = Some((k, sdp.blocks.len() - 1));
@@ -370,7 +262,7 @@ impl<'a> Interior<'a> {
         let floors = self.floors().len();
         let (run, scale) = match self.objective {
             Objective::LeastTension => {
-                let mut sdp = self.base(0);
+                let mut sdp = base(self.frame, 0);
                 sdp.blocks = self.constraint_blocks(floors, 0)?;
                 let total = f.total + f.sums.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
                 let scale = total.abs().max(1e-9);
@@ -379,7 +271,7 @@ impl<'a> Interior<'a> {
                 (sdp::solve(&sdp, None, x, warm, settings), scale)
             }
             Objective::StiffnessAlong(_) | Objective::Volume => {
-                let mut sdp = self.base(0);
+                let mut sdp = base(self.frame, 0);
                 sdp.blocks = self.constraint_blocks(floors, 0)?;
                 let kind = match self.objective {
                     Objective::StiffnessAlong(u) => {
@@ -407,14 +299,16 @@ impl<'a> Interior<'a> {
                 let floor = Floor { k: Matrix3::identity() };
                 let now = self.floor_value(x, &floor).ok_or(PlanError::NoEndStiffness)?;
                 let scale = now.abs().max(1e-12);
-                let mut sdp = self.base(1);
+                let mut sdp = base(self.frame, 1);
                 sdp.blocks = self.constraint_blocks(floors, 1)?;
-                sdp.blocks
-                    .push(self.floor_block(floor, Err(scale), 1).ok_or(PlanError::NoEndStiffness)?);
+                sdp.blocks.push(
+                    floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
+                        .ok_or(PlanError::NoEndStiffness)?,
+                );
                 sdp.c[k] = 1.0;
                 sdp.epigraph = Some((k, sdp.blocks.len() - 1));
                 let mut start = x.to_vec();
-                start.push(0.5 * now / scale);
+                start.push(if self.warm { (1.0 - 1e-3) * now / scale } else { 0.5 * now / scale });
                 let run = sdp::solve(&sdp, None, &start, warm, settings);
                 (run, scale)
             }
@@ -423,13 +317,13 @@ impl<'a> Interior<'a> {
                     .compliance_at(x, &u)
                     .ok_or_else(|| self.no_stable_tensions(f64::NEG_INFINITY))?;
                 let scale = c.abs().max(1e-300);
-                let mut sdp = self.base(1);
+                let mut sdp = base(self.frame, 1);
                 sdp.blocks = self.constraint_blocks(floors, 1)?;
-                sdp.blocks.push(self.compliance_block(&u, scale));
+                sdp.blocks.push(compliance_block(self.frame, &u, scale));
                 sdp.c[k] = -1.0;
                 sdp.epigraph = Some((k, sdp.blocks.len() - 1));
                 let mut start = x.to_vec();
-                start.push(2.0);
+                start.push(if self.warm { 1.0 + 1e-3 } else { 2.0 });
                 (sdp::solve(&sdp, None, &start, warm, settings), scale)
             }
         };
@@ -439,6 +333,76 @@ impl<'a> Interior<'a> {
         let mut x = run.x;
         x.truncate(k);
         Ok(Answer { x, upper: run.upper * scale, iterations: run.iterations, duals: run.duals })
+    }
+
+    /// Whether `x` is strictly inside the rows, the margin and the floors.
+    fn strictly_inside(&self, x: &[f64]) -> bool {
+        let f = self.frame;
+        let k = f.vars();
+        let rows = (0..f.rhs.len()).all(|r| {
+            f.rows[r * k..r * k + k].iter().zip(x).map(|(a, b)| a * b).sum::<f64>() < f.rhs[r]
+        });
+        let n = f.n;
+        let mut a = vec![0.0; n * n];
+        f.a_at(x, &mut a);
+        for i in 0..n {
+            a[i * n + i] -= self.requirements.margin;
+        }
+        rows && crate::dense::cholesky(&mut a, n)
+            && self
+                .floors()
+                .iter()
+                .all(|(floor, tau, _)| self.floor_value(x, floor).is_some_and(|v| v > *tau))
+    }
+
+    /// `x` when strictly inside; else one least-norm step onto the linearised violated rows
+    /// and margin (each moved a little inside), kept when it lands strictly inside.
+    pub(crate) fn restored(&self, x: Vec<f64>) -> Option<Vec<f64>> {
+        if self.strictly_inside(&x) {
+            return Some(x);
+        }
+        let f = self.frame;
+        let (k, n) = (f.vars(), f.n);
+        // Active constraints as J d = b.
+        let (mut jac, mut b): (Vec<Vec<f64>>, Vec<f64>) = (Vec::new(), Vec::new());
+        const INSIDE: f64 = 1e-4;
+        for r in 0..f.rhs.len() {
+            let g = &f.rows[r * k..r * k + k];
+            let slack = f.rhs[r] - g.iter().zip(&x).map(|(a, c)| a * c).sum::<f64>();
+            if slack < INSIDE {
+                jac.push(g.to_vec());
+                b.push(slack - INSIDE);
+            }
+        }
+        let m = self.requirements.margin;
+        let mut a = vec![0.0; n * n];
+        f.a_at(&x, &mut a);
+        let eigen = DMatrix::from_row_slice(n, n, &a).symmetric_eigen();
+        let i = eigen.eigenvalues.imin();
+        let needed = m + INSIDE * f.a_scale.max(m);
+        if eigen.eigenvalues[i] < needed {
+            let v = eigen.eigenvectors.column(i);
+            let h: Vec<f64> = f
+                .ai
+                .iter()
+                .map(|ai| {
+                    (0..n).map(|r| v[r] * (0..n).map(|c| ai[r * n + c] * v[c]).sum::<f64>()).sum()
+                })
+                .collect();
+            jac.push(h.iter().map(|v| -v).collect());
+            b.push(eigen.eigenvalues[i] - needed);
+        }
+        let p = jac.len();
+        let gram =
+            DMatrix::from_fn(p, p, |r, c| jac[r].iter().zip(&jac[c]).map(|(u, w)| u * w).sum());
+        let w = gram.cholesky()?.solve(&nalgebra::DVector::from_vec(b));
+        let mut restored = x;
+        for (row, wr) in jac.iter().zip(w.iter()) {
+            for (xa, g) in restored.iter_mut().zip(row) {
+                *xa += wr * g;
+            }
+        }
+        self.strictly_inside(&restored).then_some(restored)
     }
 
     /// `uᵀ J_p A⁻¹ J_pᵀ u` at `x` (`None` where `A ⊁ 0`).

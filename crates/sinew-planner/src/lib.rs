@@ -22,6 +22,8 @@
 //! solver allocates inside its iterations (clarabel builds each subproblem).
 #![deny(missing_docs)]
 
+mod along;
+mod blocks;
 mod bundle;
 mod dense;
 mod error;
@@ -36,6 +38,7 @@ mod rows;
 mod sdp;
 mod smooth;
 
+pub use along::{AlongStep, RateLimit, Step};
 pub use error::{InputProblem, PlanError};
 pub use plan::{Planner, PlannerData};
 pub use problem::{

@@ -16,7 +16,9 @@ use crate::interior;
 use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
-use crate::rows::{HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows};
+use crate::rows::{
+    HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows, rate_error, rate_rows,
+};
 
 /// The planner's model: the arm (robot, routing, statics). Immutable; one [`PlannerData`] per
 /// thread.
@@ -29,14 +31,14 @@ pub struct Planner {
 #[derive(Debug)]
 pub struct PlannerData {
     stiffness: ArmStiffnessData,
-    /// The last interior-point answer's multipliers, for a warm start.
-    pub(crate) warm: Option<interior::Warm>,
+    /// The last plan's tensions, for a rate limit and a warm start along a trajectory.
+    pub(crate) previous: Option<Vec<f64>>,
 }
 
 impl PlannerData {
     /// A workspace for `planner`.
     pub fn new(planner: &Planner) -> PlannerData {
-        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), warm: None }
+        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), previous: None }
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
@@ -76,6 +78,24 @@ impl Planner {
         requirements: &Requirements,
         settings: &PlanSettings,
     ) -> Result<Plan, PlanError> {
+        data.previous = None;
+        self.plan_step(data, q, f0, objective, requirements, settings, None).map(|(p, _, _)| p)
+    }
+
+    /// One plan; with `rate`, each tension within `rate` N of the previous plan's (kept in
+    /// `data`), and the interior-point method warm-started from that plan when there is one.
+    /// Returns the plan, whether the warm answer was accepted, and the iterations.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn plan_step(
+        &self,
+        data: &mut PlannerData,
+        q: &[f64],
+        f0: &Vector6<f64>,
+        objective: Objective,
+        requirements: &Requirements,
+        settings: &PlanSettings,
+        rate: Option<f64>,
+    ) -> Result<(Plan, bool, usize), PlanError> {
         check_inputs(f0, objective, requirements, settings)?;
         let arm = &self.arm;
         let joints = arm.routing().joint_count();
@@ -101,12 +121,32 @@ impl Planner {
         let pencil = self.pencil(sd, &set)?;
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
+        let previous = data.previous.take();
+        if let (Some(change), Some(previous)) = (rate, &previous) {
+            rate_rows(&set, previous, change, &mut linear);
+        }
+        let mut warm = false;
         let (lambda, upper, iterations) = match settings.method {
             Method::InteriorPoint => {
                 let held = held_coordinates(&set, &fixed);
                 let frame = Frame::new(&pencil, &set, &linear.merged(), &held);
-                let (answer, before) = interior::cold(&frame, objective, requirements, settings)?;
-                data.warm = Some(interior::Warm { duals: answer.duals, objective });
+                let attempt = previous.as_ref().map(|f| {
+                    let x = frame.x_of(&set.coordinates(f));
+                    interior::warm(&frame, objective, requirements, settings, x)
+                });
+                let (answer, before) = match attempt {
+                    Some(Ok(answer)) => {
+                        warm = true;
+                        (answer, 0)
+                    }
+                    Some(Err(tried)) => {
+                        let (answer, before) =
+                            interior::cold(&frame, objective, requirements, settings)
+                                .map_err(|e| rate_error(e, rate.is_some() && previous.is_some()))?;
+                        (answer, before + tried)
+                    }
+                    None => interior::cold(&frame, objective, requirements, settings)?,
+                };
                 (frame.lambda(&answer.x), answer.upper, before + answer.iterations)
             }
             Method::Bundle => {
@@ -125,7 +165,7 @@ impl Planner {
                 )?
             }
         };
-        self.answer(
+        let plan = self.answer(
             &mut data.stiffness,
             &set,
             &pencil,
@@ -134,7 +174,9 @@ impl Planner {
             &lambda,
             upper,
             iterations,
-        )
+        )?;
+        data.previous = Some(plan.tensions.clone());
+        Ok((plan, warm, iterations))
     }
 
     /// The bundle method's phases from the safest (or least-total) start: `(λ, UB, iterations)`.

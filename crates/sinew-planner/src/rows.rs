@@ -4,6 +4,7 @@
 use sinew_statics::EquilibriumSet;
 
 use crate::bundle::Linear;
+use crate::error::PlanError;
 
 /// `Nᵀ 1`: how the total tension changes per unit of each `λ`.
 pub(crate) fn column_sums(set: &EquilibriumSet) -> Vec<f64> {
@@ -81,5 +82,27 @@ pub(crate) fn fix_rows(
         down[column] = -1.0;
         linear.rows.push(down);
         linear.rhs.push(tol - value);
+    }
+}
+
+/// The rate limit `|f − f_prev| ≤ change` per cable as rows in `λ`.
+pub(crate) fn rate_rows(set: &EquilibriumSet, previous: &[f64], change: f64, linear: &mut Linear) {
+    let null = set.null_basis();
+    let k = set.dimension();
+    let p = set.particular();
+    for (c, f) in previous.iter().enumerate().take(set.cable_count()) {
+        let row: Vec<f64> = (0..k).map(|i| null[(c, i)]).collect();
+        linear.rhs.push(f + change - p[c]);
+        linear.rows.push(row.clone());
+        linear.rhs.push(p[c] - (f - change));
+        linear.rows.push(row.iter().map(|v| -v).collect());
+    }
+}
+
+/// With a rate limit, rows that no point meets are the limit's doing (or the budgets').
+pub(crate) fn rate_error(error: PlanError, limited: bool) -> PlanError {
+    match error {
+        PlanError::BudgetsInfeasible if limited => PlanError::RateLimitInfeasible,
+        e => e,
     }
 }

@@ -115,8 +115,11 @@ pub(crate) struct Settings {
     pub(crate) relative_gap: f64,
     pub(crate) scale: f64,
     pub(crate) max_iterations: usize,
-    /// Stop as soon as `φ ≥ target` (a feasibility phase), or when `UB < target`.
+    /// Stop as soon as `φ ≥ target` (a feasibility phase) and `φ − target` is at least
+    /// `centring` of `UB − target` (so that the point is well inside, not on the target's
+    /// boundary), or at the optimum when it is above the target; or when `UB < target`.
     pub(crate) target: Option<f64>,
+    pub(crate) centring: f64,
 }
 
 /// The multipliers, kept between runs for a warm start.
@@ -349,8 +352,15 @@ pub(crate) fn solve(
             / nu.max(1.0);
         let upper = upper_bound(sdp, &x, value, &gradient, &s, &works, &duals);
         best = Some((value, upper));
+        if std::env::var_os("SINEW_IPM_DEBUG").is_some() {
+            eprintln!("it {iteration}: value {value:.6e} upper {upper:.6e} mu {mu:.3e} x {x:.3?}");
+        }
         if let Some(target) = settings.target {
-            if value >= target {
+            let converged =
+                upper - value <= settings.relative_gap * value.abs().max(settings.scale);
+            if value > target
+                && (value - target >= settings.centring * (upper - target) || converged)
+            {
                 return run(x, value, upper, iteration, End::Reached, duals);
             }
             if upper < target {
@@ -535,8 +545,11 @@ fn directions(
     }
 }
 
-/// Multipliers on the central path at `x`, `y = μ/s`, `Z = μ S⁻¹`, with `μ` the least-squares
-/// fit of stationarity `∇φ + μ (−Gᵀ(1/s) + F*(S⁻¹)) = 0` (floored at a small positive value).
+/// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the
+/// least-squares fit of stationarity `∇φ + μ (−Gᵀ(1/s) + F*(S⁻¹)) = 0` (floored at a small
+/// positive value). An epigraph block gets its own `μ_t`, the one that makes the epigraph
+/// variable's stationarity exact (`∂φ/∂t + μ_t ⟨F_t, S⁻¹⟩ = 0`); the fit is then over the
+/// other coordinates.
 fn centred_duals(
     sdp: &Sdp,
     gradient: &[f64],
@@ -546,27 +559,47 @@ fn centred_duals(
     scale: f64,
 ) -> Duals {
     let k = sdp.vars();
+    let mut own = vec![None; works.len()];
+    if let Some((t, j)) = sdp.epigraph {
+        let d = sdp.blocks[j].coefficients[t].as_ref().map_or(0.0, |f| inner(f, &works[j].s_inv));
+        let mu_t = -gradient[t] / d;
+        if mu_t.is_finite() && mu_t > 0.0 {
+            own[j] = Some(mu_t);
+        }
+    }
     let mut b = vec![0.0; k];
+    let mut g = gradient.to_vec();
     for (r, sr) in s.iter().enumerate() {
         for a in 0..k {
             b[a] -= sdp.rows[r * k + a] / sr;
         }
     }
-    for (blk, w) in sdp.blocks.iter().zip(works) {
+    for (j, (blk, w)) in sdp.blocks.iter().zip(works).enumerate() {
         for a in 0..k {
             if let Some(fa) = &blk.coefficients[a] {
-                b[a] += inner(fa, &w.s_inv);
+                match own[j] {
+                    Some(mu_t) => g[a] += mu_t * inner(fa, &w.s_inv),
+                    None => b[a] += inner(fa, &w.s_inv),
+                }
             }
         }
     }
+    if let Some((t, _)) = sdp.epigraph {
+        b[t] = 0.0;
+        g[t] = 0.0;
+    }
     let bb: f64 = b.iter().map(|v| v * v).sum();
-    let gb: f64 = b.iter().zip(gradient).map(|(x, y)| x * y).sum();
+    let gb: f64 = b.iter().zip(&g).map(|(x, y)| x * y).sum();
     let nu = (s.len() + works.iter().map(|w| w.s.len().isqrt()).sum::<usize>()) as f64;
     let floor = 1e-3 * value.abs().max(scale) / nu.max(1.0);
     let mu = if bb > 0.0 { (-gb / bb).max(floor) } else { floor };
     Duals {
         y: s.iter().map(|v| mu / v).collect(),
-        z: works.iter().map(|w| w.s_inv.iter().map(|v| mu * v).collect()).collect(),
+        z: works
+            .iter()
+            .zip(&own)
+            .map(|(w, o)| w.s_inv.iter().map(|v| o.unwrap_or(mu) * v).collect())
+            .collect(),
     }
 }
 

@@ -1,0 +1,135 @@
+//! The matrix inequalities and rows of the interior-point planner's problems, in a frame's
+//! coordinates (module docs of `ipm.rs` for the blocks), each divided by a scale of its
+//! constant so that its entries are O(1).
+
+use nalgebra::Matrix3;
+
+use crate::frame::{Frame, congruence};
+use crate::sdp::{Block, Sdp};
+
+/// The floor a phase or a requirement puts on `K_fd`: `K_fd ⪰ τ K`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Floor {
+    /// `K` (N/m-less: `K_fd ⪰ τ K`).
+    pub(crate) k: Matrix3<f64>,
+}
+
+/// The base problem: the rows (with `extra` zero columns) and the box, no block.
+pub(crate) fn base(f: &Frame, extra: usize) -> Sdp {
+    let k = f.vars();
+    let width = k + extra;
+    let mut rows = Vec::with_capacity(f.rhs.len() * width);
+    for r in 0..f.rhs.len() {
+        rows.extend_from_slice(&f.rows[r * k..r * k + k]);
+        rows.extend(std::iter::repeat_n(0.0, extra));
+    }
+    let mut lo = vec![-1.0; width];
+    let mut hi = vec![1.0; width];
+    for e in k..width {
+        lo[e] = f64::NEG_INFINITY;
+        hi[e] = f64::INFINITY;
+    }
+    Sdp {
+        c0: 0.0,
+        c: vec![0.0; width],
+        rows,
+        rhs: f.rhs.clone(),
+        blocks: Vec::new(),
+        lo,
+        hi,
+        epigraph: None,
+    }
+}
+
+/// `(A(x) − shift I)/a_scale`, with `−(t_scale/a_scale) I` for an epigraph variable.
+pub(crate) fn margin_block(f: &Frame, shift: f64, extra: usize, epigraph: Option<f64>) -> Block {
+    let n = f.n;
+    let s = 1.0 / f.a_scale;
+    let mut constant: Vec<f64> = f.a0.iter().map(|v| v * s).collect();
+    for i in 0..n {
+        constant[i * n + i] -= shift * s;
+    }
+    let mut coefficients: Vec<Option<Vec<f64>>> =
+        f.ai.iter().map(|a| Some(a.iter().map(|v| v * s).collect())).collect();
+    coefficients.extend(std::iter::repeat_n(None, extra));
+    if let Some(t_scale) = epigraph {
+        let mut d = vec![0.0; n * n];
+        for i in 0..n {
+            d[i * n + i] = -t_scale * s;
+        }
+        coefficients[f.vars()] = Some(d);
+    }
+    Block { n, constant, coefficients }
+}
+
+/// `Rᵀ(A − τ J_pᵀ K J_p)R / scale`, with `τ` fixed or `τ = t_scale · t`.
+pub(crate) fn floor_block(
+    f: &Frame,
+    rotation_null: Option<&Vec<f64>>,
+    floor: Floor,
+    tau: Result<f64, f64>,
+    extra: usize,
+) -> Option<Block> {
+    let r = rotation_null?;
+    let (n, p) = (f.n, f.n - 3);
+    // Q = J_pᵀ K J_p (n × n).
+    let mut q = vec![0.0; n * n];
+    for a in 0..n {
+        for b in 0..n {
+            let mut v = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    v += f.j_x[i * n + a] * floor.k[(i, j)] * f.j_x[j * n + b];
+                }
+            }
+            q[a * n + b] = v;
+        }
+    }
+    let d = congruence(&q, r, n, p);
+    let b0 = congruence(&f.a0, r, n, p);
+    let scale = (0..p).map(|i| b0[i * p + i].abs()).fold(0.0, f64::max).max(1e-300);
+    let s = 1.0 / scale;
+    let fixed = tau.unwrap_or(0.0);
+    let constant: Vec<f64> = b0.iter().zip(&d).map(|(b, dd)| (b - fixed * dd) * s).collect();
+    let mut coefficients: Vec<Option<Vec<f64>>> =
+        f.ai.iter().map(|a| Some(congruence(a, r, n, p).iter().map(|v| v * s).collect())).collect();
+    coefficients.extend(std::iter::repeat_n(None, extra));
+    if let Err(t_scale) = tau {
+        coefficients[f.vars()] = Some(d.iter().map(|v| -t_scale * v * s).collect());
+    }
+    Some(Block { n: p, constant, coefficients })
+}
+
+/// `[[A, J_pᵀu], [uᵀJ_p, s]]` congruence-scaled by `diag(a_scale^{-1/2} I, s_scale^{-1/2})`,
+/// `s = s_scale · t`.
+pub(crate) fn compliance_block(f: &Frame, u: &nalgebra::Vector3<f64>, s_scale: f64) -> Block {
+    let n = f.n;
+    let m = n + 1;
+    let sa = 1.0 / f.a_scale;
+    let cross = 1.0 / (f.a_scale * s_scale).sqrt();
+    let mut constant = vec![0.0; m * m];
+    for r in 0..n {
+        for c in 0..n {
+            constant[r * m + c] = f.a0[r * n + c] * sa;
+        }
+        let b: f64 = (0..3).map(|i| f.j_x[i * n + r] * u[i]).sum();
+        constant[r * m + n] = b * cross;
+        constant[n * m + r] = b * cross;
+    }
+    let mut coefficients: Vec<Option<Vec<f64>>> =
+        f.ai.iter()
+            .map(|a| {
+                let mut e = vec![0.0; m * m];
+                for r in 0..n {
+                    for c in 0..n {
+                        e[r * m + c] = a[r * n + c] * sa;
+                    }
+                }
+                Some(e)
+            })
+            .collect();
+    let mut d = vec![0.0; m * m];
+    d[n * m + n] = 1.0;
+    coefficients.push(Some(d));
+    Block { n: m, constant, coefficients }
+}
