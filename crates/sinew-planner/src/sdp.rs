@@ -352,9 +352,6 @@ pub(crate) fn solve(
             / nu.max(1.0);
         let upper = upper_bound(sdp, &x, value, &gradient, &s, &works, &duals);
         best = Some((value, upper));
-        if std::env::var_os("SINEW_IPM_DEBUG").is_some() {
-            eprintln!("it {iteration}: value {value:.6e} upper {upper:.6e} mu {mu:.3e} x {x:.3?}");
-        }
         if let Some(target) = settings.target {
             let converged =
                 upper - value <= settings.relative_gap * value.abs().max(settings.scale);
