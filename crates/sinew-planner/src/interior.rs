@@ -24,7 +24,7 @@ pub(crate) fn cold(
     let (x, rows) = problem.inside_rows()?;
     let (x, stable) = problem.stable(x)?;
     let (x, floors) = problem.floors_met(x)?;
-    let answer = problem.optimise(&x, None, settings.max_iterations)?;
+    let answer = problem.optimise(&x, settings.max_iterations)?;
     Ok((answer, rows + stable + floors))
 }
 
@@ -41,7 +41,7 @@ pub(crate) fn warm(
     let mut problem = Interior::new(frame, objective, requirements, settings);
     problem.warm = true;
     let x = problem.restored(x).ok_or(0_usize)?;
-    match problem.optimise(&x, None, WARM_ITERATIONS) {
+    match problem.optimise(&x, WARM_ITERATIONS) {
         Ok(answer) => Ok(answer),
         Err(PlanError::NotConverged { iterations, .. }) => Err(iterations),
         Err(_) => Err(WARM_ITERATIONS),

@@ -18,7 +18,7 @@ use crate::blocks::{Floor, base, compliance_block, floor_block, margin_block};
 use crate::error::PlanError;
 use crate::frame::Frame;
 use crate::problem::{Objective, PlanSettings, Requirements};
-use crate::sdp::{self, Block, Duals, End, Run, Settings};
+use crate::sdp::{self, Block, End, Run, Settings};
 use crate::smooth::{EndObjective, Kind};
 
 /// How far past its target a feasibility phase goes, as a fraction of the bound's excess: a
@@ -44,7 +44,6 @@ pub(crate) struct Answer {
     /// An upper bound of the objective in the plan's sense (maximised), real units.
     pub(crate) upper: f64,
     pub(crate) iterations: usize,
-    pub(crate) duals: Duals,
 }
 
 impl<'a> Interior<'a> {
@@ -121,7 +120,7 @@ impl<'a> Interior<'a> {
         sdp.hi[k] = 1.0;
         let mut start = x0;
         start.push(tau0);
-        let run = sdp::solve(&sdp, None, &start, None, self.settings(None, 0.3, 1e-3));
+        let run = sdp::solve(&sdp, None, &start, self.settings(None, 0.3, 1e-3));
         if run.value > 0.0 {
             let mut x = run.x;
             x.pop();
@@ -152,7 +151,7 @@ impl<'a> Interior<'a> {
         let mut start = x;
         start.push((now - 0.05 * f.a_scale.max(now.abs())) / f.a_scale);
         let target = (m + 1e-9 * m.max(f.a_scale * 1e-6)) / f.a_scale;
-        let run = sdp::solve(&sdp, None, &start, None, self.settings(Some(target), 1e-9, 1e-9));
+        let run = sdp::solve(&sdp, None, &start, self.settings(Some(target), 1e-9, 1e-9));
         match run.end {
             End::Reached => {
                 let mut x = run.x;
@@ -222,7 +221,7 @@ impl<'a> Interior<'a> {
             let mut start = x.clone();
             start.push((now - 0.05 * scale) / scale);
             let target = (tau + 1e-9 * scale) / scale;
-            let run = sdp::solve(&sdp, None, &start, None, self.settings(Some(target), 1e-9, 1e-9));
+            let run = sdp::solve(&sdp, None, &start, self.settings(Some(target), 1e-9, 1e-9));
             iterations += run.iterations;
             match run.end {
                 End::Reached => {
@@ -242,18 +241,12 @@ impl<'a> Interior<'a> {
         Ok((x, iterations))
     }
 
-    /// The last phase: the objective from `x` meeting every requirement, warm multipliers
-    /// optional. The returned bound is in real units of the maximised objective (`−Σ f`,
+    /// The last phase: the objective from `x` meeting every requirement. The returned bound is in real units of the maximised objective (`−Σ f`,
     /// `−uᵀ C u` for the minimised ones).
     ///
     /// # Errors
     /// [`PlanError::NoEndStiffness`]; [`PlanError::NotConverged`].
-    pub(crate) fn optimise(
-        &self,
-        x: &[f64],
-        warm: Option<&Duals>,
-        max_iterations: usize,
-    ) -> Result<Answer, PlanError> {
+    pub(crate) fn optimise(&self, x: &[f64], max_iterations: usize) -> Result<Answer, PlanError> {
         let f = self.frame;
         let k = f.vars();
         let gap = self.settings.relative_gap;
@@ -268,7 +261,7 @@ impl<'a> Interior<'a> {
                 let scale = total.abs().max(1e-9);
                 sdp.c0 = -f.total / scale;
                 sdp.c = f.sums.iter().map(|s| -s / scale).collect();
-                (sdp::solve(&sdp, None, x, warm, settings), scale)
+                (sdp::solve(&sdp, None, x, settings), scale)
             }
             Objective::StiffnessAlong(_) | Objective::Volume => {
                 let mut sdp = base(self.frame, 0);
@@ -293,7 +286,7 @@ impl<'a> Interior<'a> {
                     settings.scale = 1.0 / scale;
                 }
                 let mut smooth = EndObjective::new(f, kind, scale);
-                (sdp::solve(&sdp, Some(&mut smooth), x, warm, settings), scale)
+                (sdp::solve(&sdp, Some(&mut smooth), x, settings), scale)
             }
             Objective::MinStiffness => {
                 let floor = Floor { k: Matrix3::identity() };
@@ -309,7 +302,7 @@ impl<'a> Interior<'a> {
                 sdp.epigraph = Some((k, sdp.blocks.len() - 1));
                 let mut start = x.to_vec();
                 start.push(if self.warm { (1.0 - 1e-3) * now / scale } else { 0.5 * now / scale });
-                let run = sdp::solve(&sdp, None, &start, warm, settings);
+                let run = sdp::solve(&sdp, None, &start, settings);
                 (run, scale)
             }
             Objective::ComplianceAlong(u) => {
@@ -324,7 +317,7 @@ impl<'a> Interior<'a> {
                 sdp.epigraph = Some((k, sdp.blocks.len() - 1));
                 let mut start = x.to_vec();
                 start.push(if self.warm { 1.0 + 1e-3 } else { 2.0 });
-                (sdp::solve(&sdp, None, &start, warm, settings), scale)
+                (sdp::solve(&sdp, None, &start, settings), scale)
             }
         };
         if run.end != End::Optimum {
@@ -332,7 +325,7 @@ impl<'a> Interior<'a> {
         }
         let mut x = run.x;
         x.truncate(k);
-        Ok(Answer { x, upper: run.upper * scale, iterations: run.iterations, duals: run.duals })
+        Ok(Answer { x, upper: run.upper * scale, iterations: run.iterations })
     }
 
     /// Whether `x` is strictly inside the rows, the margin and the floors.

@@ -25,6 +25,8 @@
 mod along;
 mod blocks;
 mod bundle;
+#[cfg(test)]
+mod checks;
 mod dense;
 mod error;
 mod frame;

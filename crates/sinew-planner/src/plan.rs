@@ -108,16 +108,35 @@ impl Planner {
         // The pose stage, once: geometry, T0, K_W and J_x at the pose.
         arm.set_pose(sd, q, f0)?;
         let fixed = self.fixed_tensions(sd, requirements)?;
-        // The least-total tensions: whether any tensions balance the load (a typed
-        // infeasibility naming the joint otherwise), and the equilibrium set they computed.
-        arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
-        let least_total: f64 = sd.tensions().iter().sum();
-        let set = arm.equilibrium_set(sd)?.clone();
-        if let Some(budget) = requirements.budget
-            && least_total > budget * (1.0 + 1e-12)
-        {
-            return Err(PlanError::BudgetTooSmall { budget, least: least_total });
-        }
+        let (set, least_total) = match settings.method {
+            // The equilibrium set and one tension stage (the pencil needs the stage's inherent
+            // stiffness); infeasibility shows in the first phase.
+            // (Any balancing tensions within the limits do: the paper's levels at one half
+            // when the closed form holds them, else the least-total policy.)
+            Method::InteriorPoint => {
+                let set = arm.equilibrium_set(sd)?.clone();
+                let half = vec![0.5; joints];
+                let by_levels = arm.statics().has_levels()
+                    && arm.set_tensions(sd, TensionChoice::Levels(&half)).is_ok();
+                if !by_levels {
+                    arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
+                }
+                (set, f64::NAN)
+            }
+            // The least-total tensions: whether any tensions balance the load (a typed
+            // infeasibility naming the joint otherwise), and the equilibrium set they computed.
+            Method::Bundle => {
+                arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
+                let least_total: f64 = sd.tensions().iter().sum();
+                let set = arm.equilibrium_set(sd)?.clone();
+                if let Some(budget) = requirements.budget
+                    && least_total > budget * (1.0 + 1e-12)
+                {
+                    return Err(PlanError::BudgetTooSmall { budget, least: least_total });
+                }
+                (set, least_total)
+            }
+        };
         let pencil = self.pencil(sd, &set)?;
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
@@ -134,18 +153,25 @@ impl Planner {
                     let x = frame.x_of(&set.coordinates(f));
                     interior::warm(&frame, objective, requirements, settings, x)
                 });
+                let limited = rate.is_some() && previous.is_some();
+                let cold = |data: &mut PlannerData| {
+                    interior::cold(&frame, objective, requirements, settings).map_err(|e| match e {
+                        PlanError::BudgetsInfeasible => {
+                            self.infeasible(data, requirements, limited)
+                        }
+                        e => e,
+                    })
+                };
                 let (answer, before) = match attempt {
                     Some(Ok(answer)) => {
                         warm = true;
                         (answer, 0)
                     }
                     Some(Err(tried)) => {
-                        let (answer, before) =
-                            interior::cold(&frame, objective, requirements, settings)
-                                .map_err(|e| rate_error(e, rate.is_some() && previous.is_some()))?;
+                        let (answer, before) = cold(data)?;
                         (answer, before + tried)
                     }
-                    None => interior::cold(&frame, objective, requirements, settings)?,
+                    None => cold(data)?,
                 };
                 (frame.lambda(&answer.x), answer.upper, before + answer.iterations)
             }
@@ -295,6 +321,29 @@ impl Planner {
         })
     }
 
+    /// Why no point meets the rows of a plan at the pose of `data`: an infeasible load (the
+    /// statics' typed error, by the least-total policy), a budget below the least total, the rate
+    /// limit, or the per-joint budgets.
+    fn infeasible(
+        &self,
+        data: &mut PlannerData,
+        requirements: &Requirements,
+        limited: bool,
+    ) -> PlanError {
+        let sd = &mut data.stiffness;
+        if let Err(e) = self.arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))
+        {
+            return e.into();
+        }
+        let least: f64 = sd.tensions().iter().sum();
+        match requirements.budget {
+            Some(budget) if least > budget * (1.0 + 1e-12) => {
+                PlanError::BudgetTooSmall { budget, least }
+            }
+            _ => rate_error(PlanError::BudgetsInfeasible, limited),
+        }
+    }
+
     /// Held levels need the decoupled closed form, and joints and levels that exist.
     fn check_fixed_levels(&self, requirements: &Requirements) -> Result<(), PlanError> {
         if requirements.fixed_levels.is_empty() {
@@ -350,7 +399,11 @@ impl Planner {
     }
 
     /// `A_0` and the `A_i` at the pose of `sd` (after a tension stage there: `K_i` and `K_W`).
-    fn pencil(&self, sd: &mut ArmStiffnessData, set: &EquilibriumSet) -> Result<Pencil, PlanError> {
+    pub(crate) fn pencil(
+        &self,
+        sd: &mut ArmStiffnessData,
+        set: &EquilibriumSet,
+    ) -> Result<Pencil, PlanError> {
         let routing = self.arm.routing();
         let dof = self.arm.dof();
         let mut a0 = Mat::<f64>::zeros(dof, dof);

@@ -31,7 +31,7 @@
 //! An epigraph variable `t` (unbounded, in one block only, not in a row) has its block's `Z`
 //! scaled so that `r_t = 0` exactly. Nothing in the bound depends on how `y` and `Z` were found.
 
-use crate::dense::{cholesky, cholesky_inverse, cholesky_log_det, cholesky_solve, inner, multiply};
+use crate::dense::{cholesky, cholesky_inverse, cholesky_solve, inner, multiply};
 
 /// One matrix inequality `F(x) = F_0 + Σ_a x_a F_a ⪰ 0` (each n × n, row-major, symmetric).
 #[derive(Debug, Clone)]
@@ -88,18 +88,6 @@ impl Sdp {
             *si = self.rhs[r] - g.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
         }
     }
-
-    /// Whether `x` is strictly inside every row and block.
-    pub(crate) fn strictly_feasible(&self, x: &[f64]) -> bool {
-        let mut s = vec![0.0; self.row_count()];
-        self.slacks(x, &mut s);
-        s.iter().all(|v| *v > 0.0)
-            && self.blocks.iter().all(|b| {
-                let mut f = vec![0.0; b.n * b.n];
-                b.at(x, &mut f);
-                cholesky(&mut f, b.n)
-            })
-    }
 }
 
 /// A smooth concave part `ψ` of the objective.
@@ -122,7 +110,7 @@ pub(crate) struct Settings {
     pub(crate) centring: f64,
 }
 
-/// The multipliers, kept between runs for a warm start.
+/// The multipliers `y` (rows) and `Z_j` (blocks).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Duals {
     pub(crate) y: Vec<f64>,
@@ -137,7 +125,6 @@ pub(crate) struct Run {
     pub(crate) upper: f64,
     pub(crate) iterations: usize,
     pub(crate) end: End,
-    pub(crate) duals: Duals,
 }
 
 /// Why a run ended.
@@ -278,12 +265,29 @@ fn upper_bound(
     bound
 }
 
-/// Run the method from the strictly feasible `x0`, with `warm` multipliers or centred ones.
+/// The certified bound at a strictly feasible `x` with any `y ≥ 0`, `Z ⪰ 0` (module docs),
+/// given `φ(x)` and `∇φ(x)`; `None` when `x` is not strictly feasible.
+pub(crate) fn bound_at(
+    sdp: &Sdp,
+    x: &[f64],
+    value: f64,
+    gradient: &[f64],
+    duals: &Duals,
+) -> Option<f64> {
+    let mut s = vec![0.0; sdp.row_count()];
+    sdp.slacks(x, &mut s);
+    let mut works: Vec<BlockWork> = sdp.blocks.iter().map(|b| BlockWork::new(b.n)).collect();
+    for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
+        b.at(x, &mut w.s);
+    }
+    s.iter().all(|v| *v >= 0.0).then(|| upper_bound(sdp, x, value, gradient, &s, &works, duals))
+}
+
+/// Run the method from the strictly feasible `x0`, with multipliers centred there.
 pub(crate) fn solve(
     sdp: &Sdp,
     mut smooth: Option<&mut dyn Smooth>,
     x0: &[f64],
-    warm: Option<&Duals>,
     settings: Settings,
 ) -> Run {
     let k = sdp.vars();
@@ -302,14 +306,7 @@ pub(crate) fn solve(
         (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
     let mut duals = Duals::default();
     let mut best: Option<(f64, f64)> = None;
-    let run = |x: Vec<f64>, value, upper, iterations, end, duals| Run {
-        x,
-        value,
-        upper,
-        iterations,
-        end,
-        duals,
-    };
+    let run = |x: Vec<f64>, value, upper, iterations, end| Run { x, value, upper, iterations, end };
     for iteration in 0..=settings.max_iterations {
         // The slacks, their factors and inverses, the objective.
         sdp.slacks(&x, &mut s);
@@ -339,13 +336,10 @@ pub(crate) fn solve(
         }
         if !interior {
             let (value, upper) = best.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
-            return run(x0.to_vec(), value, upper, iteration, End::Breakdown, duals);
+            return run(x0.to_vec(), value, upper, iteration, End::Breakdown);
         }
         if iteration == 0 {
-            duals = match warm {
-                Some(d) if d.y.len() == p && d.z.len() == works.len() => d.clone(),
-                _ => centred_duals(sdp, &gradient, &s, &works, value, settings.scale),
-            };
+            duals = centred_duals(sdp, &gradient, &s, &works, value, settings.scale);
         }
         let mu = (duals.y.iter().zip(&s).map(|(a, b)| a * b).sum::<f64>()
             + works.iter().zip(&duals.z).map(|(w, z)| inner(z, &w.s)).sum::<f64>())
@@ -358,17 +352,17 @@ pub(crate) fn solve(
             if value > target
                 && (value - target >= settings.centring * (upper - target) || converged)
             {
-                return run(x, value, upper, iteration, End::Reached, duals);
+                return run(x, value, upper, iteration, End::Reached);
             }
             if upper < target {
-                return run(x, value, upper, iteration, End::Unreachable, duals);
+                return run(x, value, upper, iteration, End::Unreachable);
             }
         }
         if upper - value <= settings.relative_gap * value.abs().max(settings.scale) {
-            return run(x, value, upper, iteration, End::Optimum, duals);
+            return run(x, value, upper, iteration, End::Optimum);
         }
         if iteration == settings.max_iterations || p + works.len() == 0 {
-            return run(x, value, upper, iteration, End::NotConverged, duals);
+            return run(x, value, upper, iteration, End::NotConverged);
         }
         // The Schur complement.
         for (e, h) in schur.iter_mut().zip(&hessian) {
@@ -410,7 +404,7 @@ pub(crate) fn solve(
                 factored[a * k + a] += 1e-12 * trace;
             }
             if !cholesky(&mut factored, k) {
-                return run(x, value, upper, iteration, End::Breakdown, duals);
+                return run(x, value, upper, iteration, End::Breakdown);
             }
         }
         // Predictor (σ = 0).
@@ -598,19 +592,4 @@ fn centred_duals(
             .map(|(w, o)| w.s_inv.iter().map(|v| o.unwrap_or(mu) * v).collect())
             .collect(),
     }
-}
-
-/// `log det` of each block at `x` (the barrier's matrix part), `None` outside.
-#[allow(dead_code)]
-pub(crate) fn log_dets(sdp: &Sdp, x: &[f64]) -> Option<f64> {
-    let mut total = 0.0;
-    for b in &sdp.blocks {
-        let mut f = vec![0.0; b.n * b.n];
-        b.at(x, &mut f);
-        if !cholesky(&mut f, b.n) {
-            return None;
-        }
-        total += cholesky_log_det(&f, b.n);
-    }
-    Some(total)
 }

@@ -38,9 +38,8 @@ pub(crate) struct EndObjective<'a> {
     column: Vec<f64>,
 }
 
-/// `A`'s Cholesky factor, `Y = A⁻¹ J_xᵀ` (n × 6 row-major), `C_x` and `K_x` at `x`.
+/// `K_x` at `x` (the factor of `A` and `Y = A⁻¹ J_xᵀ` stay in the objective's buffers).
 pub(crate) struct EndAt {
-    pub(crate) c_x: Matrix6<f64>,
     pub(crate) k_x: Matrix6<f64>,
 }
 
@@ -76,7 +75,7 @@ impl<'a> EndObjective<'a> {
         let c_x = Matrix6::from_fn(|r, c| (0..n).map(|d| j_x[r * n + d] * self.y[d * 6 + c]).sum());
         let c_x = 0.5 * (c_x + c_x.transpose());
         let k_x = compliance_inverse(&c_x).ok()?;
-        Some(EndAt { c_x, k_x: 0.5 * (k_x + k_x.transpose()) })
+        Some(EndAt { k_x: 0.5 * (k_x + k_x.transpose()) })
     }
 
     /// `P v` for the factor in `self.a` (after [`Self::end_at`]).
