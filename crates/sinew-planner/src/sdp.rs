@@ -267,6 +267,7 @@ fn upper_bound(
 
 /// The certified bound at a strictly feasible `x` with any `y ≥ 0`, `Z ⪰ 0` (module docs),
 /// given `φ(x)` and `∇φ(x)`; `None` when `x` is not strictly feasible.
+#[cfg(test)]
 pub(crate) fn bound_at(
     sdp: &Sdp,
     x: &[f64],
@@ -305,6 +306,35 @@ pub(crate) fn solve(
     let (mut ds_row, mut dy, mut ds_aff_row, mut dy_aff) =
         (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
     let mut duals = Duals::default();
+    // The rows where each coefficient is not zero, and per coefficient `F_a Z` and `S⁻¹ F_a`.
+    let supports: Vec<Vec<Option<Vec<usize>>>> = sdp
+        .blocks
+        .iter()
+        .map(|b| {
+            let n = b.n;
+            b.coefficients
+                .iter()
+                .map(|f| {
+                    f.as_ref().map(|f| {
+                        (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let mut products: Vec<Vec<(Vec<f64>, Vec<f64>)>> = sdp
+        .blocks
+        .iter()
+        .map(|b| {
+            b.coefficients
+                .iter()
+                .map(|f| match f {
+                    Some(_) => (vec![0.0; b.n * b.n], vec![0.0; b.n * b.n]),
+                    None => (Vec::new(), Vec::new()),
+                })
+                .collect()
+        })
+        .collect();
     let mut best: Option<(f64, f64)> = None;
     let run = |x: Vec<f64>, value, upper, iterations, end| Run { x, value, upper, iterations, end };
     for iteration in 0..=settings.max_iterations {
@@ -380,18 +410,47 @@ pub(crate) fn solve(
                 }
             }
         }
+        // M_ab = tr(F_a Z F_b S⁻¹) = ⟨S⁻¹ F_b, F_a Z⟩ over the rows where F_a is not zero:
+        // each A_i is made of a few 2 × 2 joint blocks, so this costs O(k² n) for them.
         for (j, b) in sdp.blocks.iter().enumerate() {
             let n = b.n;
-            let w = &mut works[j];
-            for a in 0..k {
-                let Some(fa) = &b.coefficients[a] else { continue };
-                // T = S⁻¹ F_a Z; M_ab = ⟨F_b, T⟩ = tr(F_b Z F_a S⁻¹).
-                multiply(&w.s_inv, fa, n, &mut w.t1);
-                multiply(&w.t1, &duals.z[j], n, &mut w.t2);
-                for bb in 0..k {
-                    if let Some(fb) = &b.coefficients[bb] {
-                        schur[a * k + bb] += inner(fb, &w.t2);
+            let (z, s_inv) = (&duals.z[j], &works[j].s_inv);
+            for (a, fa) in b.coefficients.iter().enumerate() {
+                let (Some(fa), Some(rows)) = (fa, &supports[j][a]) else { continue };
+                let (fz, sf) = &mut products[j][a];
+                fz.fill(0.0);
+                sf.fill(0.0);
+                for &r in rows {
+                    for q in 0..n {
+                        let v = fa[r * n + q];
+                        if v != 0.0 {
+                            for c in 0..n {
+                                fz[r * n + c] += v * z[q * n + c];
+                            }
+                        }
                     }
+                }
+                for r in 0..n {
+                    for &q in rows {
+                        let v = s_inv[r * n + q];
+                        for c in 0..n {
+                            sf[r * n + c] += v * fa[q * n + c];
+                        }
+                    }
+                }
+            }
+            for a in 0..k {
+                let Some(rows) = &supports[j][a] else { continue };
+                for bb in 0..k {
+                    if supports[j][bb].is_none() {
+                        continue;
+                    }
+                    let (fz, sf) = (&products[j][a].0, &products[j][bb].1);
+                    let mut m = 0.0;
+                    for &r in rows {
+                        m += inner(&sf[r * n..r * n + n], &fz[r * n..r * n + n]);
+                    }
+                    schur[a * k + bb] += m;
                 }
             }
         }
