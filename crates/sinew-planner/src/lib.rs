@@ -12,14 +12,27 @@
 //! `K_x = (J_x A⁻¹ J_xᵀ)⁻¹` is matrix-concave in `λ`: `wᵀ K_x w = min { δqᵀ A δq : J_x δq = w }`
 //! is a minimum of functions affine in `λ`. Hence `uᵀ K_fd u`, `λ_min(K_fd)`, `log det K_fd`
 //! and the stability margin `λ_min(A)` are concave and `uᵀ C_x u` convex: each objective
-//! ([`Objective`]) is a convex problem, whose local optimum is the global one. `pencil.rs` has
-//! the supergradients; `bundle.rs` the method (a level bundle method on clarabel LPs and QPs,
-//! no PSD cone, so no system BLAS), whose LP bound certifies every answer ([`Plan::gap`]). With
-//! a moment in the load `K_W` is not symmetric and the argument fails:
+//! ([`Objective`]) is a convex problem, whose local optimum is the global one.
+//!
+//! # Methods
+//! The default ([`Method::InteriorPoint`]) writes the non-smooth objectives and every
+//! requirement as small linear matrix inequalities (`ipm.rs`, `blocks.rs`), keeps `uᵀK_fd u` and
+//! `log det K_fd` smooth with analytic Hessians (`smooth.rs`), and runs a primal–dual
+//! interior-point method (`sdp.rs`: Mehrotra predictor–corrector, HKM direction). Every answer
+//! carries a certificate that does not depend on the method: for a feasible `λ̄` and any
+//! multipliers `y ≥ 0`, `Z ⪰ 0`, the Lagrangian is concave and bounds `φ` on the feasible set,
+//! so its linearisation at `λ̄` maximised over the closed-form box of `λ` bounds the optimum
+//! ([`Plan::gap`]). The bundle method ([`Method::Bundle`], `bundle.rs`: a level bundle method on
+//! clarabel LPs and QPs, whose LP bound certifies its answers) is kept as a second, independent
+//! method. With a moment in the load `K_W` is not symmetric and the argument fails:
 //! [`PlanError::NonConservativeLoad`].
 //!
-//! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). The
-//! solver allocates inside its iterations (clarabel builds each subproblem).
+//! [`Planner::plan_along`] re-plans along a trajectory, warm-started ([`Step`], [`RateLimit`],
+//! [`AlongStep`]).
+//!
+//! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). Both
+//! methods allocate inside their iterations (the interior-point method its small dense buffers
+//! per run, clarabel each subproblem).
 #![deny(missing_docs)]
 
 mod along;
