@@ -99,6 +99,7 @@ pub(crate) fn inner(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use faer::Mat;

@@ -498,10 +498,7 @@ pub(crate) fn solve(
         let sigma = (mu_aff / mu).clamp(0.0, 1.0).powi(3);
         let sigma_mu = sigma * mu;
         // Corrector: the right-hand side with the second-order terms.
-        dx.fill(0.0);
-        for a in 0..k {
-            dx[a] = gradient[a];
-        }
+        dx.copy_from_slice(&gradient);
         for r in 0..p {
             let coefficient = (sigma_mu - ds_aff_row[r] * dy_aff[r]) / s[r];
             for a in 0..k {
