@@ -37,6 +37,9 @@ pub struct ArmStiffness {
     planner: OnceLock<(Planner, Mutex<PlannerData>)>,
 }
 
+/// What `ArmStiffness` pickles as: the class and its constructor's arguments.
+type Reduced = (Py<PyAny>, (Py<Robot>, Py<Routing>));
+
 /// A policy by its name.
 pub fn policy(name: &str) -> PyResult<TensionPolicy> {
     TensionPolicy::ALL.into_iter().find(|p| p.name() == name).ok_or_else(|| {
@@ -72,7 +75,7 @@ impl ArmStiffness {
 
     /// Pickling by value: `ArmStiffness(robot, routing)`, whose robot and routing pickle as
     /// their files' texts (never a path). The copy evaluates bit for bit like the original.
-    fn __reduce__(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, (Py<Robot>, Py<Routing>))> {
+    fn __reduce__(&self, py: Python<'_>) -> PyResult<Reduced> {
         let class = py.get_type::<ArmStiffness>().into_any().unbind();
         Ok((class, (self.robot.clone_ref(py), self.routing.clone_ref(py))))
     }

@@ -28,6 +28,9 @@ pub struct Robot {
     texts: RobotTexts,
 }
 
+/// What `Routing` pickles as: `Routing.from_text` and its arguments.
+type RoutingReduced = (Py<PyAny>, (Py<Robot>, String, String));
+
 /// The texts a robot is built from: what it pickles as.
 #[derive(Debug, Clone)]
 struct RobotTexts {
@@ -210,7 +213,7 @@ impl Routing {
 
     /// Pickling by value: `Routing.from_text(robot, text, name)`, the robot pickled as its
     /// texts and the routing file's text.
-    fn __reduce__(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, (Py<Robot>, String, String))> {
+    fn __reduce__(&self, py: Python<'_>) -> PyResult<RoutingReduced> {
         let build = py.get_type::<Routing>().getattr("from_text")?.unbind();
         // The file's name only: a folder of the client's disk means nothing on a worker.
         let name = Path::new(&self.name)

@@ -5,7 +5,8 @@ Sinew does not schedule anything itself: ``map_evaluate`` and ``map_plan`` cut t
 ``Q`` into chunks (``chunk`` rows each, default 10 000: Dask's overhead is about 2 ms per
 task, a chunk of cdhrm5 about 40 ms), ship the model once per worker (``client.scatter(arm,
 broadcast=True)``: it pickles by value, the URDF, ``robot.toml`` and routing texts, never a
-path), and run each chunk as one task calling ``evaluate_many`` / ``plan_many`` with
+path), and run each chunk as one task (a numpy ``Q`` travels in the task graph, a dask ``Q``
+is computed where its chunks' tasks run) calling ``evaluate_many`` / ``plan_many`` with
 ``threads=1`` (a worker per core then uses its core and no more). A worker lost mid-run loses
 nothing: the chunks are in the task graph and Dask runs the lost ones again.
 
@@ -153,6 +154,9 @@ def _rows(arm: ArmStiffness, Q: Any):
             raise InputError(f"Q: expected an array of shape (N, {arm.dof}) of numbers ({e})") from e
     if Q.ndim != 2 or Q.shape[1] != arm.dof:
         raise InputError(f"Q: expected an array of shape (N, {arm.dof}), got {tuple(Q.shape)}")
+    if Q.dtype.kind not in "fiu" and Q.shape[0]:
+        # The rule of every array argument, on the client: None, booleans, complex refused.
+        arm.evaluate_many(np.asarray(Q[:1]), threads=1, raise_if_all_fail=False)
     return Q
 
 
