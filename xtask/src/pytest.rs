@@ -1,13 +1,15 @@
 //! `cargo xtask test [--locked]`: every test of the project in one command. `cargo test
 //! --workspace`, then the Python bindings: a virtualenv in `target/py-venv` (made once; pip
-//! installs numpy and pytest into it), the package assembled in `target/py-pkg/sinew` from
-//! `crates/sinew-py/python/sinew` and the extension module `cargo test` has just built (the
-//! `sinew-py` cdylib, `target/debug/deps/lib_sinew.so`: its example links the library, so the
-//! workspace build makes it with the workspace's features and nothing is compiled again), and
-//! pytest on `crates/sinew-py/tests` with that folder first on `PYTHONPATH`. pytest's "no tests
-//! collected" (exit 5) fails like any other non-zero exit. (Users install the package with
-//! `pip install ./crates/sinew-py` or `maturin develop`; building it with maturin here would
-//! compile the dependencies again with maturin's feature set, about two minutes of CI.)
+//! installs numpy, pytest, dask[array] and distributed into it), the package assembled in
+//! `target/py-pkg/sinew` from `crates/sinew-py/python/sinew` and the extension module `cargo
+//! test` has just built (the `sinew-py` cdylib, `target/debug/deps/lib_sinew.so`: its example
+//! links the library, so the workspace build makes it with the workspace's features and
+//! nothing is compiled again), and pytest on `crates/sinew-py/tests` with that folder first on
+//! `PYTHONPATH`. pytest's "no tests collected" (exit 5) fails like any other non-zero exit.
+//! `target` is `$CARGO_TARGET_DIR` when it is set (where `cargo test` then builds), else the
+//! workspace's `target/`. (Users install the package with `pip install ./crates/sinew-py` or
+//! `maturin develop`; building it with maturin here would compile the dependencies again with
+//! maturin's feature set, about two minutes of CI.)
 
 use std::path::Path;
 use std::process::Command;
@@ -15,8 +17,17 @@ use std::time::Instant;
 
 use crate::DynResult;
 
-/// What pip installs into the virtualenv: the tests' dependencies only.
-const PYTHON_PACKAGES: [&str; 2] = ["numpy", "pytest"];
+/// What pip installs into the virtualenv: the tests' dependencies only (dask's for the
+/// `sinew.dask` tests: a two-worker LocalCluster).
+const PYTHON_PACKAGES: [&str; 4] = ["numpy", "pytest", "dask[array]", "distributed"];
+
+/// Cargo's target folder: `$CARGO_TARGET_DIR` (relative to the workspace) or `target/`.
+fn target_dir(root: &Path) -> std::path::PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) if !dir.is_empty() => root.join(dir),
+        _ => root.join("target"),
+    }
+}
 
 pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     let mut locked = false;
@@ -33,7 +44,8 @@ pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     status(Command::new(&cargo).current_dir(root).args(["test", "--workspace"]).args(lock))?;
 
     let start = Instant::now();
-    let venv = root.join("target").join("py-venv");
+    let target = target_dir(root);
+    let venv = target.join("py-venv");
     let bin = venv.join("bin");
     if !bin.join("python").is_file() {
         println!("== python3 -m venv {}", venv.display());
@@ -51,14 +63,14 @@ pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     let mut paths = vec![bin.clone()];
     paths.extend(std::env::split_paths(&path));
     let path = std::env::join_paths(paths)?;
-    let package = assemble_package(root)?;
+    let package = assemble_package(root, &target)?;
     println!("== pytest crates/sinew-py/tests");
     // The `sinew` binary the tests compare with: the one `cargo test` built.
     status(
         Command::new(&python)
             .current_dir(root)
             .args(["-m", "pytest", "-q", "crates/sinew-py/tests"])
-            .env("SINEW_BIN", root.join("target").join("debug").join("sinew"))
+            .env("SINEW_BIN", target.join("debug").join("sinew"))
             .env("PYTHONPATH", &package)
             .env("PATH", &path),
     )?;
@@ -68,8 +80,8 @@ pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
 
 /// `target/py-pkg`: the Python package `sinew` (the sources of `crates/sinew-py/python/sinew`
 /// and the extension module `_sinew` that `cargo test --workspace` built), made afresh.
-fn assemble_package(root: &Path) -> DynResult<std::path::PathBuf> {
-    let built = root.join("target").join("debug").join("deps").join(format!(
+fn assemble_package(root: &Path, target: &Path) -> DynResult<std::path::PathBuf> {
+    let built = target.join("debug").join("deps").join(format!(
         "{}_sinew{}",
         std::env::consts::DLL_PREFIX,
         std::env::consts::DLL_SUFFIX
@@ -81,7 +93,7 @@ fn assemble_package(root: &Path) -> DynResult<std::path::PathBuf> {
         )
         .into());
     }
-    let out = root.join("target").join("py-pkg");
+    let out = target.join("py-pkg");
     let package = out.join("sinew");
     if package.exists() {
         std::fs::remove_dir_all(&package)?;

@@ -35,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut ok = 0;
     for _ in 0..10 {
         let start = Instant::now();
-        let batch = evaluate_many(&arm, &q, &f0, &choice);
+        let batch = evaluate_many(&arm, &q, &[f0], &choice);
         best = best.min(start.elapsed().as_secs_f64());
         ok = batch.ok.iter().filter(|&&o| o).count();
     }

@@ -1,20 +1,27 @@
 //! `sinew.ArmStiffness`: the whole arm in a pose under a load (eq. 5–21), one configuration
-//! (`evaluate`), many in parallel (`evaluate_many`), and the tension planner (`plan`).
+//! (`evaluate`), many in parallel (`evaluate_many`), and the tension planner (`plan`, and
+//! `plan_many` over many poses). It pickles by value: its robot and routing, which carry
+//! their files' texts (`model.rs`).
 
 use std::sync::{Mutex, OnceLock};
 
-use nalgebra::{Matrix3, Vector3, Vector6};
+use std::collections::BTreeMap;
+
+use nalgebra::Vector6;
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use sinew::planner::{Objective, PlanSettings, Planner, PlannerData, Requirements};
+use sinew::planner::{Planner, PlannerData};
 use sinew::statics::{Chosen, TensionChoice, TensionPolicy};
 use sinew::stiffness::ArmStiffnessData;
 
 use crate::batch::{BatchChoice, evaluate_many};
-use crate::convert::{finite, matrix, na2, reshape, vec1, vector};
+use crate::convert::{matrix, na2, reshape, vec1, vector, wrenches};
 use crate::errors::{exception, input, library};
 use crate::lazy::LazyArray;
 use crate::model::{Robot, Routing};
+use crate::plan_args::plan_args;
+use crate::plan_many::{PlanBatchResult, plan_many};
+use crate::pool::{run, threads_arg};
 use crate::results::{ArmResult, BatchResult, PlanResult};
 
 /// The model of the pipeline `Q → K_x` for a robot and a routing (Pinocchio's model), with
@@ -22,10 +29,16 @@ use crate::results::{ArmResult, BatchResult, PlanResult};
 #[pyclass(module = "sinew", frozen)]
 #[derive(Debug)]
 pub struct ArmStiffness {
+    /// What it was built from: what it pickles as.
+    robot: Py<Robot>,
+    routing: Py<Routing>,
     arm: sinew::stiffness::ArmStiffness,
     data: Mutex<ArmStiffnessData>,
     planner: OnceLock<(Planner, Mutex<PlannerData>)>,
 }
+
+/// What `ArmStiffness` pickles as: the class and its constructor's arguments.
+type Reduced = (Py<PyAny>, (Py<Robot>, Py<Routing>));
 
 /// A policy by its name.
 pub fn policy(name: &str) -> PyResult<TensionPolicy> {
@@ -45,12 +58,38 @@ fn wrench_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Vector6<f64>> {
 impl ArmStiffness {
     /// The model of `robot` with `routing`.
     #[new]
-    fn new(robot: &Robot, routing: &Routing) -> PyResult<ArmStiffness> {
-        let arm = sinew::stiffness::ArmStiffness::new(&robot.inner, &routing.inner)
+    fn new(robot: &Bound<'_, Robot>, routing: &Bound<'_, Routing>) -> PyResult<ArmStiffness> {
+        let (r, c) = (robot.get(), routing.get());
+        let arm = sinew::stiffness::ArmStiffness::new(&r.inner, &c.inner)
             .map_err(library)?
             .checking_limits();
         let data = Mutex::new(ArmStiffnessData::new(&arm));
-        Ok(ArmStiffness { arm, data, planner: OnceLock::new() })
+        Ok(ArmStiffness {
+            robot: robot.clone().unbind(),
+            routing: routing.clone().unbind(),
+            arm,
+            data,
+            planner: OnceLock::new(),
+        })
+    }
+
+    /// Pickling by value: `ArmStiffness(robot, routing)`, whose robot and routing pickle as
+    /// their files' texts (never a path). The copy evaluates bit for bit like the original.
+    fn __reduce__(&self, py: Python<'_>) -> PyResult<Reduced> {
+        let class = py.get_type::<ArmStiffness>().into_any().unbind();
+        Ok((class, (self.robot.clone_ref(py), self.routing.clone_ref(py))))
+    }
+
+    /// The robot.
+    #[getter]
+    fn robot(&self, py: Python<'_>) -> Py<Robot> {
+        self.robot.clone_ref(py)
+    }
+
+    /// The routing.
+    #[getter]
+    fn routing(&self, py: Python<'_>) -> Py<Routing> {
+        self.routing.clone_ref(py)
     }
 
     /// Degrees of freedom.
@@ -83,15 +122,20 @@ impl ArmStiffness {
     /// `"least-norm"`, `"safest"`) or `tensions` (given, checked); by default levels all 0
     /// where the routing takes them, else least-total, like `sinew arm`.
     ///
-    /// An unstable equilibrium is a result (`stable` False, `c_x`/`k_x`/`k_fd` None).
-    #[pyo3(signature = (q, wrench = None, levels = None, policy = None, tensions = None))]
+    /// An unstable equilibrium is a result (`stable` False, `c_x`/`k_x`/`k_fd` None), as
+    /// `sinew arm` reports it; with `require_stiffness=True` it raises `UnstableError`, and a
+    /// rank-deficient `J_x` (`k_x` None) raises `RankDeficientError`, with the library's
+    /// message (as Rust's `ArmStiffness::evaluate` returns them).
+    #[pyo3(signature = (q, wrench = None, levels = None, policy = None, tensions = None, require_stiffness = false))]
     fn evaluate<'py>(
         &self,
+        py: Python<'py>,
         q: &Bound<'py, PyAny>,
         wrench: Option<&Bound<'py, PyAny>>,
         levels: Option<&Bound<'py, PyAny>>,
         policy: Option<&str>,
         tensions: Option<&Bound<'py, PyAny>>,
+        require_stiffness: bool,
     ) -> PyResult<ArmResult> {
         let arm = &self.arm;
         let q = vector(q, "q", Some(arm.dof()))?;
@@ -124,11 +168,18 @@ impl ArmStiffness {
                 &mut fresh
             }
         };
-        arm.evaluate_joints(data, &q, &f0, choice).map_err(library)?;
-        let end = arm.solve_end(data).map_err(library)?;
-        let (stable, full_rank) = (end.is_stable(), end.has_end_stiffness());
+        // The Rust part with the GIL released (microseconds for cdhrm5, more for long chains).
+        let end = py.detach(|| -> PyResult<_> {
+            arm.evaluate_joints(data, &q, &f0, choice).map_err(library)?;
+            let end = arm.solve_end(data).map_err(library)?;
+            if require_stiffness {
+                end.into_result().map_err(library)?;
+            }
+            let notes: Vec<String> = end.note().iter().map(|n| n.text("None")).collect();
+            Ok((end.is_stable(), end.has_end_stiffness(), notes))
+        });
+        let (stable, full_rank, notes) = end?;
         // The ellipsoid's note is added when the ellipsoid is read (`notes`).
-        let notes = end.note().iter().map(|n| n.text("None")).collect();
         let chosen = data.statics.chosen();
         // The default in closed form is every joint at level 0.
         let levels = match chosen {
@@ -166,12 +217,14 @@ impl ArmStiffness {
         Ok(result)
     }
 
-    /// Evaluate every row of `Q` (N, dof) under one `wrench`, in parallel (the GIL released),
-    /// the tensions by `levels` (one per joint, the same for every row) or `policy`; default
-    /// as `evaluate`. A row that fails (outside the limits, NaN, infeasible) is NaN, `ok`
-    /// False, its error in `errors`; an unstable row is `ok`, `stable` False. When every row
-    /// of a non-empty batch fails, the first row's error is raised.
-    #[pyo3(signature = (Q, wrench = None, levels = None, policy = None))]
+    /// Evaluate every row of `Q` (N, dof) under `wrench` (one (6,) for every row, or (N, 6)),
+    /// in parallel with the GIL released: on `threads` threads of a pool of its own, or on
+    /// every core (rayon's global pool) without. The tensions by `levels` (one per joint, the
+    /// same for every row) or `policy`; default as `evaluate`. A row that fails (outside the
+    /// limits, NaN, infeasible) is NaN, `ok` False, its error in `errors`; an unstable row is
+    /// `ok`, `stable` False. When every row of a non-empty batch fails, the first row's error
+    /// is raised (unless `raise_if_all_fail` is False).
+    #[pyo3(signature = (Q, wrench = None, levels = None, policy = None, threads = None, raise_if_all_fail = true))]
     #[allow(non_snake_case)]
     fn evaluate_many<'py>(
         &self,
@@ -180,11 +233,14 @@ impl ArmStiffness {
         wrench: Option<&Bound<'py, PyAny>>,
         levels: Option<&Bound<'py, PyAny>>,
         policy: Option<&str>,
+        threads: Option<i64>,
+        raise_if_all_fail: bool,
     ) -> PyResult<BatchResult> {
         let arm = &self.arm;
         let dof = arm.dof();
         let (rows, q) = matrix(Q, "Q", dof)?;
-        let f0 = wrench_of(wrench)?;
+        let f0 = wrenches(wrench, rows)?;
+        let threads = threads_arg(threads)?;
         let joints = arm.robot().joint_count();
         let choice = match (levels, policy) {
             (Some(_), Some(_)) => return Err(input("give at most one of levels and policy")),
@@ -192,9 +248,10 @@ impl ArmStiffness {
             (None, Some(p)) => BatchChoice::Policy(self::policy(p)?),
             (None, None) => BatchChoice::Default,
         };
-        let batch = py.detach(|| evaluate_many(arm, &q, &f0, &choice));
+        let batch = py.detach(|| run(threads, || evaluate_many(arm, &q, &f0, &choice)))?;
         if let Some((_, kind, message)) = batch.errors.first()
             && batch.errors.len() == rows
+            && raise_if_all_fail
         {
             return Err(exception(*kind, format!("every row failed; row 0: {message}")));
         }
@@ -235,66 +292,26 @@ impl ArmStiffness {
         k_des: Option<&Bound<'py, PyAny>>,
         margin: f64,
         budget: Option<f64>,
-        joint_budgets: Option<std::collections::BTreeMap<usize, f64>>,
-        fixed_levels: Option<std::collections::BTreeMap<usize, f64>>,
+        joint_budgets: Option<BTreeMap<usize, f64>>,
+        fixed_levels: Option<BTreeMap<usize, f64>>,
         gap: f64,
     ) -> PyResult<PlanResult> {
         let arm = &self.arm;
         // The planner's pose stage refuses angles outside the limits.
         let q = vector(q, "q", Some(arm.dof()))?;
         let f0 = wrench_of(wrench)?;
-        let direction = match direction {
-            Some(d) => {
-                let u = vector(d, "direction", Some(3))?;
-                let u = Vector3::new(u[0], u[1], u[2]);
-                let n = u.norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(input("direction: must be a finite, non-zero vector"));
-                }
-                Some(u / n)
-            }
-            None => None,
-        };
-        let need = |what: &str| {
-            direction.ok_or_else(|| input(format!("objective {what} needs a direction")))
-        };
-        let objective = match objective {
-            "stiffness-along" => Objective::StiffnessAlong(need("stiffness-along")?),
-            "compliance-along" => Objective::ComplianceAlong(need("compliance-along")?),
-            "min-stiffness" => Objective::MinStiffness,
-            "volume" => Objective::Volume,
-            "least-tension" => Objective::LeastTension,
-            other => {
-                return Err(input(format!(
-                    "objective: `{other}` is not one of stiffness-along, compliance-along, min-stiffness, volume, least-tension"
-                )));
-            }
-        };
-        let k_des = match k_des {
-            Some(k) => {
-                let (rows, v) = matrix(k, "k_des", 3)?;
-                if rows != 3 {
-                    return Err(input(format!("k_des: expected shape (3, 3), got ({rows}, 3)")));
-                }
-                finite(&v, "k_des")?;
-                Some(Matrix3::from_row_slice(&v))
-            }
-            None => None,
-        };
-        let requirements = Requirements {
-            margin,
-            budget,
+        let args = plan_args(
+            objective,
+            direction,
             k_min,
             k_des,
-            joint_budgets: joint_budgets.unwrap_or_default().into_iter().collect(),
-            fixed_levels: fixed_levels.unwrap_or_default().into_iter().collect(),
-        };
-        let settings = PlanSettings { relative_gap: gap, ..PlanSettings::default() };
-        let (planner, data) = self.planner.get_or_init(|| {
-            let planner = Planner::new(arm.clone());
-            let data = Mutex::new(PlannerData::new(&planner));
-            (planner, data)
-        });
+            margin,
+            budget,
+            joint_budgets,
+            fixed_levels,
+            gap,
+        )?;
+        let (planner, data) = self.planner();
         let plan = py
             .detach(|| {
                 let mut fresh;
@@ -306,11 +323,11 @@ impl ArmStiffness {
                         &mut fresh
                     }
                 };
-                planner.plan(data, &q, &f0, objective, &requirements, &settings)
+                planner.plan(data, &q, &f0, args.objective, &args.requirements, &args.settings)
             })
             .map_err(library)?;
         Ok(PlanResult {
-            objective: objective.name(),
+            objective: args.objective.name(),
             value: plan.value,
             gap: plan.gap,
             lambda_: vec1(py, &plan.lambda).unbind(),
@@ -325,6 +342,52 @@ impl ArmStiffness {
         })
     }
 
+    /// `plan` at every row of `Q` (N, dof) under `wrench` (one (6,) for every row, or (N, 6)),
+    /// with the same objective and requirements: the poses are independent and planned in
+    /// parallel with the GIL released, on `threads` threads (a pool of its own) or every core.
+    /// One row per pose; a row that fails (outside the limits, infeasible, no stable tensions,
+    /// a requirement unreachable) is NaN, `ok` False, its error in `errors`. When every row
+    /// of a non-empty batch fails, the first row's error is raised (unless
+    /// `raise_if_all_fail` is False).
+    #[pyo3(signature = (Q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, fixed_levels = None, gap = 1e-6, threads = None, raise_if_all_fail = true))]
+    #[allow(non_snake_case)]
+    fn plan_many<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        wrench: Option<&Bound<'py, PyAny>>,
+        objective: &str,
+        direction: Option<&Bound<'py, PyAny>>,
+        k_min: Option<f64>,
+        k_des: Option<&Bound<'py, PyAny>>,
+        margin: f64,
+        budget: Option<f64>,
+        joint_budgets: Option<BTreeMap<usize, f64>>,
+        fixed_levels: Option<BTreeMap<usize, f64>>,
+        gap: f64,
+        threads: Option<i64>,
+        raise_if_all_fail: bool,
+    ) -> PyResult<PlanBatchResult> {
+        let (rows, q) = matrix(Q, "Q", self.arm.dof())?;
+        let f0 = wrenches(wrench, rows)?;
+        let threads = threads_arg(threads)?;
+        let args = plan_args(
+            objective,
+            direction,
+            k_min,
+            k_des,
+            margin,
+            budget,
+            joint_budgets,
+            fixed_levels,
+            gap,
+        )?;
+        let (planner, _) = self.planner();
+        let batch = py.detach(|| run(threads, || plan_many(planner, &q, &f0, &args)))?;
+        let has_levels = self.arm.statics().has_levels();
+        PlanBatchResult::new(py, args.objective.name(), batch, has_levels, raise_if_all_fail)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "sinew.ArmStiffness(robot={:?}, dof={}, cables={}, decoupled={})",
@@ -333,6 +396,17 @@ impl ArmStiffness {
             self.arm.routing().cable_count(),
             self.arm.routing().is_decoupled()
         )
+    }
+}
+
+impl ArmStiffness {
+    /// The planner of this arm and its workspace for `plan`, made on first use.
+    fn planner(&self) -> &(Planner, Mutex<PlannerData>) {
+        self.planner.get_or_init(|| {
+            let planner = Planner::new(self.arm.clone());
+            let data = Mutex::new(PlannerData::new(&planner));
+            (planner, data)
+        })
     }
 }
 

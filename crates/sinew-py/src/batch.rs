@@ -79,11 +79,13 @@ impl Fixed {
     }
 }
 
-/// Evaluate every row of `q` (rows × dof, row-major) under the load `f0`.
+/// Evaluate every row of `q` (rows × dof, row-major) under the load `f0`: one wrench for
+/// every row (`f0.len() == 1`) or one per row (`f0.len() == rows`). In parallel on the rayon
+/// pool it is called in (the global pool outside any).
 pub fn evaluate_many(
     arm: &ArmStiffness,
     q: &[f64],
-    f0: &Vector6<f64>,
+    f0: &[Vector6<f64>],
     choice: &BatchChoice,
 ) -> Batch {
     let dof = arm.dof();
@@ -97,11 +99,13 @@ pub fn evaluate_many(
         .zip(t0.par_chunks_mut(CHUNK * dof.max(1)))
         .zip(tensions.par_chunks_mut(CHUNK * cables.max(1)))
         .zip(q.par_chunks(CHUNK * dof.max(1)))
+        .enumerate()
         .for_each_init(
             || ArmStiffnessData::new(arm),
-            |data, (((fixed, t0), tensions), q)| {
+            |data, (chunk, (((fixed, t0), tensions), q))| {
                 for (r, out) in fixed.iter_mut().enumerate() {
                     let qr = &q[r * dof..(r + 1) * dof];
+                    let f0 = wrench_of_row(f0, chunk * CHUNK + r);
                     row(arm, data, qr, f0, choice, out);
                     if out.ok {
                         t0[r * dof..(r + 1) * dof].copy_from_slice(&data.statics.t0);
@@ -136,6 +140,11 @@ pub fn evaluate_many(
         }
     }
     batch
+}
+
+/// Row `r`'s wrench: the one wrench of every row, or its own.
+pub fn wrench_of_row(f0: &[Vector6<f64>], r: usize) -> &Vector6<f64> {
+    if f0.len() == 1 { &f0[0] } else { &f0[r] }
 }
 
 /// One row: the arm's checks (limits, finiteness) and evaluation, into `out`.

@@ -8,6 +8,7 @@ use sinew::indicators::{AngleGrid, JointProbe, sweep_joint};
 use crate::convert::{na2, vec1, vec2, vector};
 use crate::errors::{input, library};
 use crate::model::{Robot, Routing};
+use crate::pool::{run, threads_arg};
 
 /// The most grid points per axis (as `sinew sweep`).
 const MAX_GRID_POINTS: usize = 1001;
@@ -130,9 +131,10 @@ pub fn joint_range(
 
 /// The maps of joint `joint` (0-based) over a `points × points` grid of its two angles under
 /// `torque` (Fig. 5; `sinew sweep`), in parallel with the GIL released. The grid spans the
-/// range both of the joint's axes allow, unless `lower`/`upper` (rad) narrow it.
+/// range both of the joint's axes allow, unless `lower`/`upper` (rad) narrow it. On `threads`
+/// threads (a pool of its own), or every core (rayon's global pool) without.
 #[pyfunction]
-#[pyo3(signature = (robot, routing, joint, torque, points = 41, lower = None, upper = None))]
+#[pyo3(signature = (robot, routing, joint, torque, points = 41, lower = None, upper = None, threads = None))]
 pub fn sweep(
     py: Python<'_>,
     robot: &Robot,
@@ -142,7 +144,9 @@ pub fn sweep(
     points: usize,
     lower: Option<f64>,
     upper: Option<f64>,
+    threads: Option<i64>,
 ) -> PyResult<SweepResult> {
+    let threads = threads_arg(threads)?;
     let (r, c) = (&*robot.inner, &*routing.inner);
     let tau = torque_of(torque)?;
     if points > MAX_GRID_POINTS {
@@ -157,7 +161,9 @@ pub fn sweep(
         upper: upper.unwrap_or(jx.upper.min(jy.upper)),
         points,
     };
-    let maps = py.detach(|| sweep_joint(r, c, joint, tau, grid, &|_, _| ())).map_err(library)?;
+    let maps = py
+        .detach(|| run(threads, || sweep_joint(r, c, joint, tau, grid, &|_, _| ())))?
+        .map_err(library)?;
     let n = points;
     let map = |f: fn(&sinew::indicators::SweepCell) -> f64| -> PyResult<Py<PyArray2<f64>>> {
         let data = maps.cells.iter().map(|cell| cell.as_ref().map_or(f64::NAN, f)).collect();

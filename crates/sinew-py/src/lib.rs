@@ -15,7 +15,20 @@ mod errors;
 mod indicators;
 mod lazy;
 mod model;
+mod plan_args;
+mod plan_many;
+mod pool;
 mod results;
+
+/// The number of threads a batch call with `threads` runs on (`None`: rayon's global pool),
+/// read by rayon inside the pool the call would use: how the tests see that `threads=n`
+/// means n threads.
+#[pyfunction]
+#[pyo3(name = "_pool_threads", signature = (threads = None))]
+fn pool_threads(py: Python<'_>, threads: Option<i64>) -> PyResult<usize> {
+    let threads = pool::threads_arg(threads)?;
+    py.detach(|| pool::run(threads, pool::current_threads))
+}
 
 /// The extension module `sinew._sinew`, re-exported by the `sinew` package.
 #[pymodule]
@@ -27,12 +40,14 @@ fn _sinew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<results::ArmResult>()?;
     m.add_class::<results::BatchResult>()?;
     m.add_class::<results::PlanResult>()?;
+    m.add_class::<plan_many::PlanBatchResult>()?;
     m.add_class::<indicators::JointRange>()?;
     m.add_class::<indicators::SweepResult>()?;
     m.add_function(wrap_pyfunction!(model::load_robot, m)?)?;
     m.add_function(wrap_pyfunction!(model::load_routing, m)?)?;
     m.add_function(wrap_pyfunction!(indicators::joint_range, m)?)?;
     m.add_function(wrap_pyfunction!(indicators::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(pool_threads, m)?)?;
     m.add("SinewError", py.get_type::<errors::SinewError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;
     m.add("InfeasibleError", py.get_type::<errors::InfeasibleError>())?;

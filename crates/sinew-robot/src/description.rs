@@ -54,7 +54,20 @@ impl RobotDescription {
         let path = if path.is_dir() { path.join(DESCRIPTION_FILE) } else { path.to_path_buf() };
         let text = std::fs::read_to_string(&path)
             .map_err(|source| RobotError::Io { path: path.clone(), source })?;
-        let file: DescriptionFile = toml::from_str(&text).map_err(|e| {
+        RobotDescription::from_toml_str(&text, path)
+    }
+
+    /// A description from the text of a `robot.toml`; `path` names the file in messages and
+    /// its folder resolves the URDF's relative path (nothing is read: a caller that holds the
+    /// URDF's text too builds the robot with [`Robot::from_urdf_str`] and [`Self::settings`],
+    /// e.g. a model unpickled where the robot folder does not exist).
+    ///
+    /// # Errors
+    /// [`RobotError::InvalidDescription`] when the text is not valid,
+    /// [`RobotError::InvalidGravity`] for a non-finite gravity vector.
+    pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<RobotDescription> {
+        let path = path.as_ref().to_path_buf();
+        let file: DescriptionFile = toml::from_str(text).map_err(|e| {
             RobotError::InvalidDescription { path: path.clone(), message: e.to_string() }
         })?;
         if !file.gravity.iter().all(|g| g.is_finite()) {

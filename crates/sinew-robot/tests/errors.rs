@@ -371,3 +371,26 @@ fn assert_evaluates_finitely(robot: &Robot) {
         assert!((0..m.ncols()).all(|c| (0..m.nrows()).all(|r| m[(r, c)].is_finite())));
     }
 }
+
+#[test]
+fn a_description_from_its_text_is_the_one_read_from_its_folder() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/cdhrm5");
+    let read = sinew_robot::RobotDescription::read(&dir).unwrap();
+    let text = std::fs::read_to_string(dir.join("robot.toml")).unwrap();
+    let parsed =
+        sinew_robot::RobotDescription::from_toml_str(&text, dir.join("robot.toml")).unwrap();
+    assert_eq!(parsed, read);
+    // The robot built from the two texts alone (no file read) is the one loaded from the folder.
+    let urdf = std::fs::read_to_string(&read.urdf).unwrap();
+    let name = read.urdf.display().to_string();
+    let robot = Robot::from_urdf_str(&urdf, &name, &parsed.settings).unwrap();
+    assert_eq!(robot, sinew_robot::load(&dir).unwrap());
+    // A bad text names the path it was given.
+    let err = sinew_robot::RobotDescription::from_toml_str("gravity = 1", "pickled/robot.toml")
+        .unwrap_err();
+    assert!(matches!(err, RobotError::InvalidDescription { .. }), "{err:?}");
+    assert!(err.to_string().contains("pickled/robot.toml"), "{err}");
+    let nan = "urdf = \"x.urdf\"\ntip_link = \"tip\"\ngravity = [0.0, nan, 0.0]\n";
+    let err = sinew_robot::RobotDescription::from_toml_str(nan, "r.toml").unwrap_err();
+    assert!(matches!(err, RobotError::InvalidGravity { .. }), "{err:?}");
+}

@@ -11,6 +11,18 @@ owns ``q[2*i]`` and ``q[2*i + 1]``.
 >>> r = arm.evaluate(np.zeros(robot.dof), [0, 5, 0, 0, 0, 0])
 >>> r.stable, r.k_fd.shape
 (True, (3, 3))
+
+Every object pickles by value (the URDF, ``robot.toml`` and routing texts, never a path), and
+the batch calls (``evaluate_many``, ``plan_many``, ``sweep``) take ``threads=``; ``sinew.dask``
+(optional: ``pip install "./crates/sinew-py[dask]"``) runs them chunk by chunk on a Dask
+cluster.
+
+Array arguments follow one rule: C or Fortran order, strided views, lists and tuples are read
+as given (and copied: no argument is ever written); float16/float32 are widened to float64
+exactly, integers converted (exact up to 2**53); None, booleans, complex numbers and strings
+raise ``InputError`` naming the argument and the shape expected, as do a wrong shape and a NaN
+in ``q``, ``wrench``, ``levels`` or ``tensions``. A NaN in a row of ``Q`` fails that row only
+(``ok`` False, its error in ``errors``).
 """
 
 from ._sinew import (
@@ -21,6 +33,7 @@ from ._sinew import (
     InputError,
     JointRange,
     NumericalError,
+    PlanBatchResult,
     PlanResult,
     RankDeficientError,
     Robot,
@@ -47,6 +60,7 @@ __all__ = [
     "NumericalError",
     "OBJECTIVES",
     "POLICIES",
+    "PlanBatchResult",
     "PlanResult",
     "RankDeficientError",
     "Robot",

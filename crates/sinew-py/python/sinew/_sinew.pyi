@@ -2,6 +2,17 @@
 
 Units are SI (m, rad, N, N m); joints, cables and rows are numbered from 0; every array is
 float64 unless marked bool.
+
+Arrays in: C or Fortran order, strided views, lists and tuples are read as given and copied
+(no argument is ever written); float16/float32 widen to float64 exactly, integers convert
+(exact up to 2**53); None, booleans, complex numbers and strings raise InputError naming the
+argument and the shape expected. A NaN in a row of ``Q`` fails that row only.
+
+``threads``: the batch calls run on a rayon pool of exactly that many threads (never rayon's
+global pool), or on every core when None; the GIL is released while they run.
+
+Pickling: Robot, Routing and ArmStiffness pickle by value (the URDF, robot.toml and routing
+file texts; never a path) and evaluate bit for bit like the original when unpickled.
 """
 
 from collections.abc import Mapping
@@ -29,10 +40,12 @@ class InfeasibleError(SinewError):
     """The cables cannot hold the load within their limits; a plan's requirements unreachable."""
 
 class UnstableError(SinewError):
-    """K_q + K_W is not positive definite (raised by the planner; evaluate returns stable=False)."""
+    """K_q + K_W is not positive definite: raised by ``evaluate(..., require_stiffness=True)``
+    (without it, evaluate returns stable=False, as ``sinew arm`` does)."""
 
 class RankDeficientError(SinewError):
-    """J_x has rank < 6."""
+    """J_x has rank < 6: raised by ``plan`` (an objective needs K_x; ``sinew plan`` exits 1)
+    and by ``evaluate(..., require_stiffness=True)`` (without it, k_x is None)."""
 
 class NumericalError(SinewError):
     """The computation failed."""
@@ -40,10 +53,20 @@ class NumericalError(SinewError):
 class Robot:
     """A robot folder loaded: a serial chain of revolute joints grouped into joints."""
 
+    @classmethod
+    def from_texts(cls, urdf: str, description: str, gravity: bool = True) -> Robot:
+        """The robot of a URDF text and a ``robot.toml`` text (nothing read from disk)."""
+    @property
+    def urdf(self) -> str:
+        """The URDF's text."""
+    @property
+    def description(self) -> str:
+        """The text of ``robot.toml``."""
     @property
     def name(self) -> str: ...
     @property
-    def path(self) -> str: ...
+    def path(self) -> Optional[str]:
+        """The folder it was loaded from; None when built from texts (unpickled)."""
     @property
     def dof(self) -> int:
         """Revolute joints: the length of ``q``."""
@@ -68,8 +91,17 @@ class Robot:
 class Routing:
     """A cable routing of a robot."""
 
+    @classmethod
+    def from_text(cls, robot: Robot, text: str, name: str = "cables.toml") -> Routing:
+        """The routing of a routing file's text for ``robot``."""
     @property
-    def path(self) -> str: ...
+    def robot(self) -> Robot: ...
+    @property
+    def text(self) -> str:
+        """The routing file's text."""
+    @property
+    def path(self) -> Optional[str]:
+        """The file it was read from; None when built from a text (unpickled)."""
     @property
     def cables(self) -> list[str]:
         """Cable names in routing order (the order of every tension vector)."""
@@ -164,10 +196,37 @@ class PlanResult:
     stable: bool
     iterations: int
 
+class PlanBatchResult:
+    """Stacked results of ``plan_many``: row r is ``Q[r]``; failed rows are NaN."""
+
+    objective: str
+    ok: Bool
+    value: F64
+    gap: F64
+    tensions: F64
+    """(N, cables)."""
+    total_tension: F64
+    levels: Optional[F64]
+    """(N, joints), None when the routing has no levels."""
+    k_fd: F64
+    """(N, 3, 3), NaN where J_x has rank < 6."""
+    c_x: F64
+    """(N, 6, 6)."""
+    min_eigenvalue: F64
+    stable: Bool
+    iterations: npt.NDArray[np.int64]
+    errors: list[tuple[int, str, str]]
+    """``(row, kind, message)`` of each failed row."""
+    def __len__(self) -> int: ...
+
 class ArmStiffness:
     """The model ``Q → K_x`` of a robot and a routing, with its workspace."""
 
     def __init__(self, robot: Robot, routing: Routing) -> None: ...
+    @property
+    def robot(self) -> Robot: ...
+    @property
+    def routing(self) -> Routing: ...
     @property
     def dof(self) -> int: ...
     @property
@@ -183,16 +242,21 @@ class ArmStiffness:
         levels: Optional[ArrayLike] = None,
         policy: Optional[Policy] = None,
         tensions: Optional[ArrayLike] = None,
+        require_stiffness: bool = False,
     ) -> ArmResult:
-        """Evaluate at ``q`` under ``wrench``; at most one of levels, policy, tensions."""
+        """Evaluate at ``q`` under ``wrench``; at most one of levels, policy, tensions.
+        ``require_stiffness``: raise UnstableError / RankDeficientError instead of None."""
     def evaluate_many(
         self,
         Q: ArrayLike,
         wrench: Optional[ArrayLike] = None,
         levels: Optional[ArrayLike] = None,
         policy: Optional[Policy] = None,
+        threads: Optional[int] = None,
+        raise_if_all_fail: bool = True,
     ) -> BatchResult:
-        """Every row of ``Q`` (N, dof) in parallel; raises only when every row fails."""
+        """Every row of ``Q`` (N, dof) in parallel under ``wrench`` ((6,) for every row, or
+        (N, 6)); raises only when every row fails (and ``raise_if_all_fail``)."""
     def plan(
         self,
         q: ArrayLike,
@@ -208,6 +272,23 @@ class ArmStiffness:
         gap: float = 1e-6,
     ) -> PlanResult:
         """The tensions that optimise the end stiffness (``sinew plan``)."""
+    def plan_many(
+        self,
+        Q: ArrayLike,
+        wrench: Optional[ArrayLike] = None,
+        objective: PlanObjective = "min-stiffness",
+        direction: Optional[ArrayLike] = None,
+        k_min: Optional[float] = None,
+        k_des: Optional[ArrayLike] = None,
+        margin: float = 1e-3,
+        budget: Optional[float] = None,
+        joint_budgets: Optional[Mapping[int, float]] = None,
+        fixed_levels: Optional[Mapping[int, float]] = None,
+        gap: float = 1e-6,
+        threads: Optional[int] = None,
+        raise_if_all_fail: bool = True,
+    ) -> PlanBatchResult:
+        """``plan`` at every row of ``Q`` (N, dof) in parallel; a typed failure per row."""
 
 class JointRange:
     """One universal joint alone over its feasible tension interval (``sinew joint``)."""
@@ -254,4 +335,5 @@ def sweep(
     points: int = 41,
     lower: Optional[float] = None,
     upper: Optional[float] = None,
+    threads: Optional[int] = None,
 ) -> SweepResult: ...

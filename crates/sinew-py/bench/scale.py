@@ -1,0 +1,99 @@
+"""Python at scale (docs/performance.md): on cdhrm5 (decoupled, E4's load, levels 0.5),
+``evaluate_many`` with ``threads=1`` and ``threads=2``, ``sinew.dask.map_evaluate`` on a
+LocalCluster of 2 single-threaded worker processes, all on the same 10**6 rows in the same
+run; Dask's own per-task overhead; the pickled model's size and the time to ship it to the
+workers.
+
+Build the release module first, in its own virtualenv (as bench.py):
+    python3 -m venv target/py-bench && target/py-bench/bin/pip install maturin numpy "dask[array]" distributed
+    (cd crates/sinew-py && VIRTUAL_ENV=$PWD/../../target/py-bench ../../target/py-bench/bin/maturin develop --release)
+    target/py-bench/bin/python crates/sinew-py/bench/scale.py [--rows 1000000] [--repeat 3]
+"""
+
+import argparse
+import os
+import pickle
+import time
+from pathlib import Path
+
+import distributed
+import numpy as np
+
+import sinew
+import sinew.dask
+
+ROOT = Path(__file__).resolve().parents[3]
+E4_F0 = np.array([0.0, 5.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def best(f, repeat):
+    """The least wall time of ``repeat`` calls, and the last result."""
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = f()
+        times.append(time.perf_counter() - t)
+    return min(times), out
+
+
+def noop(x):
+    return x
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--rows", type=int, default=1_000_000)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--chunk", type=int, default=sinew.dask.DEFAULT_CHUNK)
+    args = parser.parse_args()
+    robot = sinew.load_robot(ROOT / "robots" / "cdhrm5")
+    arms = {m: sinew.ArmStiffness(robot, sinew.load_routing(robot, m))
+            for m in ("decoupled", "routed")}
+    arm = arms["decoupled"]
+    rng = np.random.default_rng(1)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    Q = lo + (hi - lo) * rng.random((args.rows, robot.dof))
+    levels = [0.5] * 5
+    n = args.rows
+    print(f"cores: {os.cpu_count()}; rows: {n:,}; repeat: best of {args.repeat}")
+
+    one, b1 = best(lambda: arm.evaluate_many(Q, E4_F0, levels=levels, threads=1), args.repeat)
+    two, b2 = best(lambda: arm.evaluate_many(Q, E4_F0, levels=levels, threads=2), args.repeat)
+    assert b1.errors == b2.errors
+    print(f"evaluate_many threads=1: {one:.3f} s ({n / one / 1e3:.0f} k rows/s)")
+    print(f"evaluate_many threads=2: {two:.3f} s ({n / two / 1e3:.0f} k rows/s), "
+          f"{one / two:.2f}x threads=1")
+
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    client = distributed.Client(cluster)
+    try:
+        # Warm the workers (import sinew, first pool) before timing.
+        sinew.dask.map_evaluate(arm, Q[:2 * args.chunk], wrench=E4_F0, levels=levels,
+                                chunk=args.chunk, client=client)
+        dt, m = best(lambda: sinew.dask.map_evaluate(
+            arm, Q, wrench=E4_F0, levels=levels, chunk=args.chunk, client=client), args.repeat)
+        assert m.errors == b1.errors and m.k_fd.tobytes() == b1.k_fd.tobytes()
+        tasks = -(-n // args.chunk)
+        print(f"map_evaluate, 2 workers x 1 thread, chunk {args.chunk}: {dt:.3f} s "
+              f"({n / dt / 1e3:.0f} k rows/s), {one / dt:.2f}x evaluate_many(threads=1); "
+              f"{tasks} tasks; time beyond the ideal (threads=1 time / 2) per task: "
+              f"{(dt - one / 2) / tasks * 1e3:.1f} ms")
+        k = 500
+        per_task, _ = best(lambda: client.gather(client.map(noop, range(k), pure=False)),
+                           args.repeat)
+        print(f"Dask's own overhead: {k} empty tasks in {per_task:.3f} s, "
+              f"{per_task / k * 1e3:.2f} ms per task (2 workers)")
+        for name, a in arms.items():
+            blob = pickle.dumps(a)
+            loads, _ = best(lambda: pickle.loads(blob), 20)
+            ship, _ = best(lambda: client.scatter(a, broadcast=True, hash=False), 10)
+            print(f"pickled ArmStiffness ({name}): {len(blob):,} bytes; unpickled in "
+                  f"{loads * 1e3:.2f} ms; scatter to both workers {ship * 1e3:.1f} ms")
+    finally:
+        client.close()
+        cluster.close()
+
+
+if __name__ == "__main__":
+    main()

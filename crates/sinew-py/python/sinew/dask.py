@@ -1,0 +1,322 @@
+"""Stiffness maps over whole workspaces on a Dask cluster (optional: ``pip install
+"./crates/sinew-py[dask]"``, which brings ``dask[array]`` and ``distributed``).
+
+Sinew does not schedule anything itself: ``map_evaluate`` and ``map_plan`` cut the rows of
+``Q`` into chunks (``chunk`` rows each, default 10 000: Dask's overhead is about 2 ms per
+task, a chunk of cdhrm5 about 40 ms), ship the model once per worker (``client.scatter(arm,
+broadcast=True)``: it pickles by value, the URDF, ``robot.toml`` and routing texts, never a
+path), and run each chunk as one task (a numpy ``Q`` travels in the task graph, a dask ``Q``
+is computed where its chunks' tasks run) calling ``evaluate_many`` / ``plan_many`` with
+``threads=1`` (a worker per core then uses its core and no more). A worker lost mid-run loses
+nothing: the chunks are in the task graph and Dask runs the lost ones again.
+
+>>> import numpy as np, sinew, sinew.dask
+>>> robot = sinew.load_robot("robots/cdhrm5")
+>>> arm = sinew.ArmStiffness(robot, sinew.load_routing(robot))
+>>> Q = np.zeros((100_000, 10)) + 0.1
+>>> m = sinew.dask.map_evaluate(arm, Q, wrench=[0, 5, 0, 0, 0, 0], levels=[0.5] * 5)
+>>> m.stable.mean(), m.k_fd.shape                    # doctest: +SKIP
+
+``client`` is None (a ``distributed.LocalCluster`` of one single-threaded worker process per
+core, started and closed by the call), a scheduler address (``"tcp://host:8786"``: the path
+past one machine), or a ``distributed.Client``. With ``compute=False`` the fields are dask
+arrays (``errors`` a ``dask.delayed`` list) and nothing runs until ``result.compute()``;
+``progress=True`` shows Dask's own progress bar while it runs. A row that fails is a row of
+the result (``ok`` False, NaN, its error in ``errors``); when every row fails, the first row's
+error is raised, as ``evaluate_many`` does.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from typing import Any, Optional
+
+import numpy as np
+
+try:
+    import dask
+    import dask.array as da
+    import distributed
+except ImportError as e:  # pragma: no cover - the message is the point
+    raise ImportError(
+        "sinew.dask needs dask[array] and distributed: pip install './crates/sinew-py[dask]'"
+    ) from e
+
+from ._sinew import (
+    ArmStiffness,
+    InfeasibleError,
+    InputError,
+    NumericalError,
+    RankDeficientError,
+    UnstableError,
+)
+
+__all__ = ["DEFAULT_CHUNK", "MapResult", "map_evaluate", "map_plan"]
+
+DEFAULT_CHUNK = 10_000
+"""Rows per task unless ``chunk`` says otherwise."""
+
+
+class MapResult:
+    """The fields of ``BatchResult`` (``map_evaluate``) or ``PlanBatchResult`` (``map_plan``),
+    one row per row of ``Q``: numpy arrays, or dask arrays with ``compute=False``. ``errors``
+    lists ``(row, kind, message)`` of every failed row (rows of the whole ``Q``)."""
+
+    def __init__(self, fields: dict, client: Optional["distributed.Client"] = None):
+        self._names = list(fields)
+        for name, value in fields.items():
+            setattr(self, name, value)
+        self._client = client
+
+    def __len__(self) -> int:
+        return int(self.ok.shape[0])
+
+    def __repr__(self) -> str:
+        kind = "dask" if isinstance(self.ok, da.Array) else "numpy"
+        return f"sinew.dask.MapResult(rows={len(self)}, {kind}, fields={self._names})"
+
+    def compute(self, progress: bool = False) -> "MapResult":
+        """The numpy result of a ``compute=False`` map (itself when already computed)."""
+        if not isinstance(self.ok, da.Array):
+            return self
+        client = self._client or distributed.get_client()
+        values = [getattr(self, name) for name in self._names]
+        futures = client.compute(values)
+        if progress:
+            distributed.progress(futures)
+        return MapResult(dict(zip(self._names, client.gather(futures))))
+
+
+def _evaluate_chunk(arm, Q, wrench, offset, levels=None, policy=None):
+    """One task: ``evaluate_many`` on one chunk with ``threads=1``, errors renumbered."""
+    b = arm.evaluate_many(Q, wrench, levels=levels, policy=policy, threads=1,
+                          raise_if_all_fail=False)
+    out = {name: getattr(b, name) for name in _EVALUATE}
+    out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
+    return out
+
+
+def _plan_chunk(arm, Q, wrench, offset, options=None):
+    """One task: ``plan_many`` on one chunk with ``threads=1``, errors renumbered."""
+    b = arm.plan_many(Q, wrench, threads=1, raise_if_all_fail=False, **(options or {}))
+    out = {name: getattr(b, name) for name in _plan_fields(arm)}
+    out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
+    return out
+
+
+_EXCEPTIONS = {"input": InputError, "infeasible": InfeasibleError, "unstable": UnstableError,
+               "rank-deficient": RankDeficientError}
+
+
+def _all_errors(*lists):
+    return [e for errors in lists for e in errors]
+
+
+# Each field's trailing shape (from the model) and dtype.
+_EVALUATE = {
+    "ok": (lambda arm: (), np.bool_),
+    "stable": (lambda arm: (), np.bool_),
+    "min_eigenvalue": (lambda arm: (), np.float64),
+    "t0": (lambda arm: (arm.dof,), np.float64),
+    "tensions": (lambda arm: (arm.cables,), np.float64),
+    "c_x": (lambda arm: (6, 6), np.float64),
+    "k_x": (lambda arm: (6, 6), np.float64),
+    "k_fd": (lambda arm: (3, 3), np.float64),
+}
+_PLAN = {
+    "ok": (lambda arm: (), np.bool_),
+    "value": (lambda arm: (), np.float64),
+    "gap": (lambda arm: (), np.float64),
+    "tensions": (lambda arm: (arm.cables,), np.float64),
+    "total_tension": (lambda arm: (), np.float64),
+    "levels": (lambda arm: (arm.joints,), np.float64),
+    "k_fd": (lambda arm: (3, 3), np.float64),
+    "c_x": (lambda arm: (6, 6), np.float64),
+    "min_eigenvalue": (lambda arm: (), np.float64),
+    "stable": (lambda arm: (), np.bool_),
+    "iterations": (lambda arm: (), np.int64),
+}
+
+
+def _plan_fields(arm):
+    return {k: v for k, v in _PLAN.items() if k != "levels" or arm.has_levels}
+
+
+def _rows(arm: ArmStiffness, Q: Any):
+    """``Q`` as a numpy or dask array of shape (N, dof), checked on the client."""
+    if Q is None:
+        raise InputError(f"Q: expected an array of shape (N, {arm.dof}), got None")
+    if not isinstance(Q, da.Array):
+        try:
+            Q = np.asarray(Q)
+        except (TypeError, ValueError) as e:
+            raise InputError(f"Q: expected an array of shape (N, {arm.dof}) of numbers ({e})") from e
+    if Q.ndim != 2 or Q.shape[1] != arm.dof:
+        raise InputError(f"Q: expected an array of shape (N, {arm.dof}), got {tuple(Q.shape)}")
+    if Q.dtype.kind not in "fiu" and Q.shape[0]:
+        # The rule of every array argument, on the client: None, booleans, complex refused.
+        arm.evaluate_many(np.asarray(Q[:1]), threads=1, raise_if_all_fail=False)
+    return Q
+
+
+def _wrench_rows(wrench: Any, rows: int):
+    """None, one wrench for every row (numpy (6,)), or a per-row (N, 6) array to chunk."""
+    if wrench is None:
+        return None, False
+    if isinstance(wrench, da.Array):
+        w = wrench
+    else:
+        w = np.asarray(wrench)
+    if w.ndim == 2 and w.shape[0] == rows and rows != 1 and w.shape[1] == 6:
+        return w, True
+    if isinstance(w, da.Array):
+        w = w.compute()
+    if w.shape == (1, 6):
+        w = w[0]
+    if w.shape != (6,):
+        raise InputError(
+            f"wrench: expected shape (6,), (1, 6) or ({rows}, 6) (one row of Q each), got {tuple(w.shape)}"
+        )
+    return w, False
+
+
+def _block(x, a: int, b: int):
+    """Rows a:b of a numpy array (a copy: it goes into the task graph) or of a dask array
+    (a lazy slice, computed where the task runs)."""
+    return x[a:b] if isinstance(x, da.Array) else np.ascontiguousarray(x[a:b])
+
+
+class _Session:
+    """The client a map runs on; one it started (``client`` None or an address) is closed
+    when the map has run, unless the result is lazy."""
+
+    def __init__(self, client):
+        self.cluster = None
+        self.owned = False
+        if client is None:
+            n = os.cpu_count() or 1
+            self.cluster = distributed.LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+            )
+            self.client = distributed.Client(self.cluster)
+            self.owned = True
+        elif isinstance(client, str):
+            self.client = distributed.Client(client)
+            self.owned = True
+        elif isinstance(client, distributed.Client):
+            self.client = client
+        else:
+            raise InputError(
+                f"client: expected None, a scheduler address or a distributed.Client, got {type(client).__name__}"
+            )
+
+    def close(self):
+        if self.owned:
+            self.client.close()
+            if self.cluster is not None:
+                self.cluster.close()
+
+
+def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
+    """Cut ``Q`` into chunks, run ``task(model, Q_chunk, wrench_chunk, offset)`` on each,
+    and stack the fields."""
+    if not isinstance(arm, ArmStiffness):
+        raise InputError(f"arm: expected a sinew.ArmStiffness, got {type(arm).__name__}")
+    chunk = DEFAULT_CHUNK if chunk is None else chunk
+    if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
+        raise InputError(f"chunk: expected a number of rows ≥ 1, got {chunk!r}")
+    Q = _rows(arm, Q)
+    rows = int(Q.shape[0])
+    wrench, per_row = _wrench_rows(wrench, rows)
+    session = _Session(client)
+    try:
+        # The model, once per worker (it pickles by value); the tasks refer to it by key.
+        model = session.client.scatter(arm, broadcast=True)
+        starts = list(range(0, rows, int(chunk)))
+        parts = []
+        for a in starts:
+            b = min(a + int(chunk), rows)
+            w = _block(wrench, a, b) if per_row else wrench
+            parts.append((a, b, dask.delayed(task, pure=True)(model, _block(Q, a, b), w, a)))
+        if compute:
+            futures = session.client.compute([p for _, _, p in parts])
+            if progress:
+                distributed.progress(futures)
+            done = session.client.gather(futures)
+            out = {}
+            for name, (shape, dtype) in fields.items():
+                if done:
+                    out[name] = np.concatenate([d[name] for d in done])
+                else:
+                    out[name] = np.zeros((0, *shape(arm)), dtype=dtype)
+            out["errors"] = _all_errors(*[d["errors"] for d in done])
+            if rows and len(out["errors"]) == rows:
+                # As evaluate_many / plan_many: a map whose every row failed raises.
+                _, kind, message = out["errors"][0]
+                raise _EXCEPTIONS.get(kind, NumericalError)(f"every row failed; row 0: {message}")
+            return MapResult(out)
+        out = {}
+        for name, (shape, dtype) in fields.items():
+            blocks = [da.from_delayed(p[name], shape=(b - a, *shape(arm)), dtype=dtype)
+                      for a, b, p in parts]
+            out[name] = (da.concatenate(blocks) if blocks
+                         else da.zeros((0, *shape(arm)), dtype=dtype))
+        out["errors"] = dask.delayed(_all_errors)(*[p["errors"] for _, _, p in parts])
+        lazy = MapResult(out, session.client)
+        lazy._session = session  # keeps a cluster it started alive while the result lives
+        session = None
+        return lazy
+    finally:
+        if session is not None:
+            session.close()
+
+
+def map_evaluate(
+    arm: ArmStiffness,
+    Q: Any,
+    wrench: Any = None,
+    levels: Any = None,
+    policy: Optional[str] = None,
+    chunk: Optional[int] = None,
+    client: Any = None,
+    compute: bool = True,
+    progress: bool = False,
+) -> MapResult:
+    """``arm.evaluate_many(Q, wrench, levels=…, policy=…)`` on a Dask cluster, chunk by chunk
+    (``threads=1`` per chunk): the same fields, bit for bit, failed rows included. ``Q`` is
+    (N, dof), a numpy or dask array; ``wrench`` one (6,) for every row or (N, 6)."""
+    Q = _rows(arm, Q)
+    if levels is not None:
+        levels = np.asarray(levels, dtype=np.float64)
+    # The arguments checked on the client, once, on at most one row.
+    w, per_row = _wrench_rows(wrench, int(Q.shape[0]))
+    arm.evaluate_many(np.zeros((0, arm.dof)), None if w is None or per_row else w,
+                      levels=levels, policy=policy, threads=1)
+
+    return _run(arm, Q, wrench, chunk, client, compute, progress,
+                functools.partial(_evaluate_chunk, levels=levels, policy=policy), _EVALUATE)
+
+
+def map_plan(
+    arm: ArmStiffness,
+    Q: Any,
+    wrench: Any = None,
+    chunk: Optional[int] = None,
+    client: Any = None,
+    compute: bool = True,
+    progress: bool = False,
+    **options: Any,
+) -> MapResult:
+    """``arm.plan_many(Q, wrench, **options)`` on a Dask cluster, chunk by chunk (``threads=1``
+    per chunk): the same fields, bit for bit, failed rows included. ``options`` are
+    ``plan``'s (``objective``, ``direction``, ``k_min``, ``margin``, ``budget``, …)."""
+    for bad in ("threads", "raise_if_all_fail"):
+        if bad in options:
+            raise InputError(f"{bad}: map_plan sets it (threads=1 per chunk)")
+    Q = _rows(arm, Q)
+    w, per_row = _wrench_rows(wrench, int(Q.shape[0]))
+    arm.plan_many(np.zeros((0, arm.dof)), None if w is None or per_row else w, threads=1,
+                  **options)
+    return _run(arm, Q, wrench, chunk, client, compute, progress,
+                functools.partial(_plan_chunk, options=options), _plan_fields(arm))
