@@ -19,6 +19,7 @@ use crate::convert::{matrix, na2, reshape, vec1, vector, wrenches};
 use crate::errors::{exception, input, library};
 use crate::lazy::LazyArray;
 use crate::model::{Robot, Routing};
+use crate::plan_along::along_result;
 use crate::plan_args::plan_args;
 use crate::plan_many::{PlanBatchResult, plan_many};
 use crate::pool::{run, threads_arg};
@@ -256,7 +257,9 @@ impl ArmStiffness {
             return Err(exception(*kind, format!("every row failed; row 0: {message}")));
         }
         let cables = batch.cables;
-        let bools = |v: &[bool]| numpy_bool(py, v);
+        let bools = |v: &[bool]| -> PyResult<Py<PyAny>> {
+            Ok(PyArray1::from_slice(py, v).into_any().unbind())
+        };
         Ok(BatchResult {
             ok: bools(&batch.ok)?,
             stable: bools(&batch.stable)?,
@@ -388,6 +391,40 @@ impl ArmStiffness {
         PlanBatchResult::new(py, args.objective.name(), batch, has_levels, raise_if_all_fail)
     }
 
+    /// One plan per row of `Q`, each warm-started from the one before; `max_rate` (N/s) and `dt`
+    /// (s) bound each cable's change per step (module docs of `plan_along.rs`).
+    #[pyo3(signature = (Q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, gap = 1e-6, max_rate = None, dt = None))]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    fn plan_along<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        wrench: Option<&Bound<'py, PyAny>>,
+        objective: &str,
+        direction: Option<&Bound<'py, PyAny>>,
+        k_min: Option<f64>,
+        k_des: Option<&Bound<'py, PyAny>>,
+        margin: f64,
+        budget: Option<f64>,
+        joint_budgets: Option<BTreeMap<usize, f64>>,
+        gap: f64,
+        max_rate: Option<f64>,
+        dt: Option<f64>,
+    ) -> PyResult<PlanBatchResult> {
+        let args = plan_args(
+            objective,
+            direction,
+            k_min,
+            k_des,
+            margin,
+            budget,
+            joint_budgets,
+            None,
+            gap,
+        )?;
+        along_result(py, self.planner(), (Q, wrench), &args, (max_rate, dt))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "sinew.ArmStiffness(robot={:?}, dof={}, cables={}, decoupled={})",
@@ -408,9 +445,4 @@ impl ArmStiffness {
             (planner, data)
         })
     }
-}
-
-/// A numpy bool array from a slice.
-fn numpy_bool(py: Python<'_>, v: &[bool]) -> PyResult<Py<PyAny>> {
-    Ok(PyArray1::from_slice(py, v).into_any().unbind())
 }

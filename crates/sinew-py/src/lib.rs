@@ -15,6 +15,7 @@ mod errors;
 mod indicators;
 mod lazy;
 mod model;
+mod plan_along;
 mod plan_args;
 mod plan_many;
 mod pool;

@@ -18,7 +18,7 @@ use crate::plan_args::PlanArgs;
 const CHUNK: usize = 4;
 
 /// One row's plan, or its failure.
-type RowPlan = Result<sinew::planner::Plan, (ErrorKind, String)>;
+pub type RowPlan = Result<sinew::planner::Plan, (ErrorKind, String)>;
 
 /// The plans of a batch, row-major; a failed row is NaN (0 iterations), `ok` false and its
 /// error in `errors`.
@@ -59,8 +59,6 @@ pub struct PlanBatch {
 pub fn plan_many(planner: &Planner, q: &[f64], f0: &[Vector6<f64>], args: &PlanArgs) -> PlanBatch {
     let arm = planner.arm();
     let dof = arm.dof();
-    let cables = arm.routing().cable_count();
-    let joints = arm.robot().joint_count();
     let rows = q.len().checked_div(dof).unwrap_or(0);
     let mut plans: Vec<Option<RowPlan>> = vec![None; rows];
     plans.par_chunks_mut(CHUNK).zip(q.par_chunks(CHUNK * dof.max(1))).enumerate().for_each_init(
@@ -75,6 +73,14 @@ pub fn plan_many(planner: &Planner, q: &[f64], f0: &[Vector6<f64>], args: &PlanA
             }
         },
     );
+    stack(planner, plans)
+}
+
+/// The plans of the rows stacked into a [`PlanBatch`] (`None`: a row never planned).
+pub fn stack(planner: &Planner, plans: Vec<Option<RowPlan>>) -> PlanBatch {
+    let arm = planner.arm();
+    let (cables, joints) = (arm.routing().cable_count(), arm.robot().joint_count());
+    let rows = plans.len();
     let nan = |n: usize| vec![f64::NAN; rows * n];
     let mut batch = PlanBatch {
         rows,
@@ -156,6 +162,9 @@ pub struct PlanBatchResult {
     pub(crate) iterations: Py<PyAny>,
     /// `(row, kind, message)` of every failed row.
     pub(crate) errors: Vec<(usize, String, String)>,
+    /// `plan_along` only: whether each step's warm-started answer was accepted (N,) bool;
+    /// None for `plan_many`.
+    pub(crate) warm: Option<Py<PyAny>>,
 }
 
 #[pymethods]
@@ -211,6 +220,7 @@ impl PlanBatchResult {
                 .into_iter()
                 .map(|(r, kind, message)| (r, kind.to_string(), message))
                 .collect(),
+            warm: None,
         })
     }
 }

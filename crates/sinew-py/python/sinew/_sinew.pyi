@@ -216,6 +216,8 @@ class PlanBatchResult:
     stable: Bool
     iterations: npt.NDArray[np.int64]
     errors: list[tuple[int, str, str]]
+    warm: Optional[npt.NDArray[np.bool_]]
+    """``plan_along`` only: whether each step's warm-started answer was accepted."""
     """``(row, kind, message)`` of each failed row."""
     def __len__(self) -> int: ...
 
@@ -289,6 +291,24 @@ class ArmStiffness:
         raise_if_all_fail: bool = True,
     ) -> PlanBatchResult:
         """``plan`` at every row of ``Q`` (N, dof) in parallel; a typed failure per row."""
+    def plan_along(
+        self,
+        Q: ArrayLike,
+        wrench: Optional[ArrayLike] = None,
+        objective: PlanObjective = "min-stiffness",
+        direction: Optional[ArrayLike] = None,
+        k_min: Optional[float] = None,
+        k_des: Optional[ArrayLike] = None,
+        margin: float = 1e-3,
+        budget: Optional[float] = None,
+        joint_budgets: Optional[Mapping[int, float]] = None,
+        gap: float = 1e-6,
+        max_rate: Optional[float] = None,
+        dt: Optional[float] = None,
+    ) -> PlanBatchResult:
+        """One certified plan per row of ``Q`` (N, dof), in order, each warm-started from the
+        step before (``warm``); ``max_rate`` (N/s) with ``dt`` (s) bounds each cable's change
+        per step. A failed step is NaN in its row and the next starts cold."""
 
 class JointRange:
     """One universal joint alone over its feasible tension interval (``sinew joint``)."""
