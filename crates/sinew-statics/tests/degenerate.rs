@@ -4,6 +4,8 @@
 //! closure that can still be held, an unreachable load, bad limits. Each gets a typed answer
 //! with the exact numbers or a typed error, never a panic or a NaN.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
+// `[0..2]` is a list of one joint (its DOF range), as `groups` takes.
+#![allow(clippy::single_range_in_vec_init)]
 
 use std::ops::Range;
 
