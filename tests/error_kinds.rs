@@ -283,6 +283,12 @@ fn nested_errors_arrive_by_one_path() {
     // Built by hand around the normalisation, the kind is still found.
     let e = Error::Stiffness(Box::new(StiffnessError::Statics(infeasible())));
     assert_eq!(e.kind(), ErrorKind::Infeasible);
+    // A crate's own errors land in its own variant.
+    let e = Error::from(IndicatorError::GridTooSmall { points: 1, min: 2 });
+    assert!(matches!(e, Error::Indicators(IndicatorError::GridTooSmall { points: 1, min: 2 })));
+    let e = Error::from(PlanError::BudgetsInfeasible);
+    assert!(matches!(&e, Error::Planner(p) if matches!(**p, PlanError::BudgetsInfeasible)));
+    assert_eq!(e.kind(), PlanError::BudgetsInfeasible.kind());
 }
 
 #[test]

@@ -162,7 +162,8 @@ fn every_policy_balances_the_load_within_the_limits_on_the_new_robots() {
                         .collect();
                     let rel = norm(&residual) / norm(&data.t0);
                     worst_residual = worst_residual.max(rel);
-                    assert!(rel <= 1e-9, "{} {q:?} {policy:?}: residual {rel:e}", case.name);
+                    // A few times the worst measured, 4.9e-15 (the library accepts 1e-9).
+                    assert!(rel <= 2e-14, "{} {q:?} {policy:?}: residual {rel:e}", case.name);
                     let limits = statics.cable_limits();
                     for (c, [lo, hi]) in limits.iter().enumerate() {
                         assert!(
@@ -542,6 +543,11 @@ fn compliance_matches_the_nonlinear_equilibrium_on_the_new_robots() {
                 let jac = elastic.newton_matrix(q);
                 let q_star = elastic.solve(q, &jac, &Vector6::zeros());
                 let mut errors = Vec::new();
+                let reach = {
+                    let mut rd = RobotData::new(&case.robot);
+                    case.robot.forward_kinematics(&mut rd, q).unwrap();
+                    case.robot.point_position(&rd, &case.robot.tip_point()).unwrap().norm()
+                };
                 for axis in 0..6 {
                     let mut dw = Vector6::zeros();
                     dw[axis] = probe * if axis < 3 { 1e-3 } else { 1e-4 };
@@ -555,7 +561,12 @@ fn compliance_matches_the_nonlinear_equilibrium_on_the_new_robots() {
                         assert!(dx.norm() <= 1e-12, "{}: moved {dx:?} under {dw:?}", case.name);
                         continue;
                     }
-                    errors.push((dx - linear).norm() / linear.norm());
+                    // Translations over the reach L (tip distance from the base) and rotations
+                    // in radians: metres and radians weighted alike, not summed raw.
+                    let weigh = |v: Vector6<f64>| {
+                        Vector6::from_fn(|i, _| if i < 3 { v[i] / reach } else { v[i] })
+                    };
+                    errors.push(weigh(dx - linear).norm() / weigh(linear).norm());
                 }
                 let e = errors.iter().fold(0.0_f64, |m, x| m.max(*x));
                 println!(
@@ -569,7 +580,8 @@ fn compliance_matches_the_nonlinear_equilibrium_on_the_new_robots() {
         }
         println!("{}: worst Newton error {worst:.2e} over {checked} equilibria", case.name);
         assert!(checked >= 2, "{}: only {checked} stable equilibria", case.name);
-        assert!(worst <= 1e-3, "{}: C_x off by {worst:e}", case.name);
+        // A few times the worst measured (snake 1.8e-6, ua3x4 4.0e-7, reach-weighted).
+        assert!(worst <= 1e-5, "{}: C_x off by {worst:e}", case.name);
     }
 }
 

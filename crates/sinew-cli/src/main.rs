@@ -24,7 +24,7 @@ mod sweep_cmd;
 
 use std::process::ExitCode;
 
-use clap::Parser;
+use clap::Parser as _;
 
 use crate::cli::{Cli, Command, ImportSource};
 use crate::error::CliError;
@@ -40,9 +40,46 @@ fn run(cli: &Cli) -> Result<(), CliError> {
     }
 }
 
+/// clap's usage error as one line naming the option: its message without the `error: `
+/// prefix, the usage and the `--help` hint, the remaining lines joined by `; `.
+fn usage_line(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let parts: Vec<String> = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty())
+        .map(|l| {
+            l.strip_prefix("error: ").unwrap_or(l).split_whitespace().collect::<Vec<_>>().join(" ")
+        })
+        .collect();
+    if parts.is_empty() {
+        "no command given: see `sinew --help`".to_owned()
+    } else {
+        parts.join("; ")
+    }
+}
+
 fn main() -> ExitCode {
-    // clap prints its own usage errors (exit 2) and --help / --version (exit 0).
-    let cli = Cli::parse();
+    // --help and --version print as clap does (exit 0); a usage error is one line, exit 2.
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => match e.kind() {
+            clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
+                e.exit()
+            }
+            clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                eprintln!(
+                    "sinew: no command given: routing, joint, arm, sweep, plan or import (see `sinew --help`)"
+                );
+                return ExitCode::from(2);
+            }
+            _ => {
+                eprintln!("sinew: {}", usage_line(&e));
+                return ExitCode::from(2);
+            }
+        },
+    };
     match run(&cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -274,3 +274,128 @@ fn operational_point_off_the_last_link_is_an_error() {
     .unwrap_err();
     assert!(matches!(e, ImportError::UnknownOperationalSet { .. }), "{e:?}");
 }
+
+/// `e`'s message starts with `file:line:column:` and names `element`.
+fn assert_names(e: &ImportError, place: (&str, u32, u32), element: &str) {
+    assert_eq!(at(e), place, "{e}");
+    let message = e.to_string();
+    let (file, line, column) = place;
+    assert!(message.starts_with(&format!("{file}:{line}:{column}: ")), "{message}");
+    assert!(message.contains(element), "{message} does not name {element}");
+    assert!(!message.contains('\n'), "{message}");
+}
+
+#[test]
+fn an_empty_links_element_is_refused_at_links() {
+    let e = run("<bodies_system>\n  <links>\n  </links>\n</bodies_system>\n", CABLES, None);
+    assert!(matches!(e, ImportError::NoLinks { .. }), "{e:?}");
+    assert_names(&e, ("b.xml", 2, 3), "<links>");
+}
+
+#[test]
+fn a_link_of_another_kind_is_refused_naming_it() {
+    let soft = bodies("U_XY", "0.2", "0").replace("link_rigid", "link_soft");
+    let e = run(&soft, CABLES, None);
+    match &e {
+        ImportError::UnexpectedElement { element, parent, .. } => {
+            assert_eq!(
+                (element.as_str(), parent.as_str()),
+                (r#"<link_soft num="1" name="arm">"#, "<links>")
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, ("b.xml", 3, 5), "<link_soft num=\"1\" name=\"arm\">");
+}
+
+#[test]
+fn links_numbered_out_of_file_order_are_refused() {
+    for num in ["2", "0", "one"] {
+        let wrong = bodies("U_XY", "0.2", "0").replace(r#"num="1""#, &format!(r#"num="{num}""#));
+        let e = run(&wrong, CABLES, None);
+        assert!(matches!(e, ImportError::LinkOrder { expected: 1, .. }), "{num}: {e:?}");
+        assert_names(&e, ("b.xml", 3, 5), &format!(r#"<link_rigid num="{num}" name="arm">"#));
+        assert!(e.to_string().contains("num should be 1"), "{e}");
+    }
+}
+
+#[test]
+fn joint_limits_the_wrong_way_round_name_the_coordinate() {
+    let inverted = bodies("U_XY", "0.2", "0").replace(r#"q_max="1 1""#, r#"q_max="1 -2""#);
+    let e = run(&inverted, CABLES, None);
+    match &e {
+        ImportError::InvalidJointLimits { link, name, coordinate, lower, upper, .. } => {
+            assert_eq!((*link, name.as_str(), *coordinate), (1, "arm", 2));
+            assert_eq!((*lower, *upper), (-1.0, -2.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, ("b.xml", 3, 36), "`arm`");
+}
+
+#[test]
+fn an_empty_cable_set_is_refused_naming_its_id() {
+    let empty = CABLES.replace("</cables>", "  <cable_set id=\"empty\"></cable_set>\n</cables>");
+    let e = run(&bodies("U_XY", "0.2", "0"), &empty, Some("empty"));
+    match &e {
+        ImportError::EmptyCableSet { id, .. } => assert_eq!(id, "empty"),
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, ("c.xml", 17, 3), "`empty`");
+}
+
+#[test]
+fn two_cables_of_one_name_are_refused_at_the_second() {
+    // The cable of set `one` (lines 3–9) twice: the copy starts on line 10.
+    let lines: Vec<&str> = CABLES.lines().collect();
+    let cable = lines[2..9].join("\n");
+    let twice = CABLES.replacen("  </cable_set>", &format!("{cable}\n  </cable_set>"), 1);
+    let e = run(&bodies("U_XY", "0.2", "0"), &twice, None);
+    match &e {
+        ImportError::DuplicateCable { cable, .. } => assert_eq!(cable, "c"),
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, ("c.xml", 10, 5), "`c`");
+}
+
+#[test]
+fn an_operational_set_without_a_point_is_refused() {
+    let op = "<operational_spaces default_operational_set=\"p\">\n  <operational_set id=\"p\">\n    <orientation_euler_xyz name=\"o\"/>\n  </operational_set>\n</operational_spaces>";
+    let e = import_caspr(
+        Source { name: "b.xml", text: &bodies("U_XY", "0.2", "0") },
+        Source { name: "c.xml", text: CABLES },
+        Some(Source { name: "o.xml", text: op }),
+        &ImportOptions::named("t"),
+    )
+    .unwrap_err();
+    match &e {
+        ImportError::NoOperationalPoint { id, .. } => assert_eq!(id, "p"),
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, ("o.xml", 2, 3), "`p`");
+}
+
+#[test]
+fn a_file_that_cannot_be_read_or_written_is_named() {
+    let dir = std::env::temp_dir().join(format!("sinew-import-io-{}", std::process::id()));
+    let missing = dir.join("missing-bodies.xml");
+    let e = sinew_import::import_caspr_files(&missing, &missing, None, &ImportOptions::named("t"))
+        .unwrap_err();
+    match &e {
+        ImportError::Io { path, .. } => assert_eq!(path, &missing),
+        other => panic!("{other:?}"),
+    }
+    assert!(e.to_string().contains("missing-bodies.xml"), "{e}");
+    assert!(e.place().is_none());
+    // Writing into a folder that does not exist names the first file.
+    let folder = import_caspr(
+        Source { name: "b.xml", text: &bodies("U_XY", "0.2", "0") },
+        Source { name: "c.xml", text: CABLES },
+        None,
+        &ImportOptions::named("t"),
+    )
+    .unwrap();
+    let e = folder.write_into(&dir.join("not-there")).unwrap_err();
+    let ImportError::Io { path, .. } = &e else { panic!("{e:?}") };
+    assert!(path.starts_with(dir.join("not-there")), "{e}");
+}

@@ -121,11 +121,13 @@ pub fn distribute_with_policy(
         });
     }
     let program = Program::new(set, policy);
+    // A set of dimension 0 is one point (f = f_p): no program, no polish (the safest
+    // program's margin variable would be polished on an empty answer).
     let (x, iterations) = if k == 0 {
         (Vec::new(), 0)
     } else {
         match program.solve()? {
-            Solved::Point { x, iterations } => (x, iterations),
+            Solved::Point { x, iterations } => (program.polish(x), iterations),
             Solved::Infeasible { z, .. } => {
                 return Err(limits_certificate(
                     set,
@@ -136,7 +138,6 @@ pub fn distribute_with_policy(
             }
         }
     };
-    let x = program.polish(x);
     let lambda = x[..k].to_vec();
     set.tensions(&lambda, tensions)?;
     let (lower, upper) = (set.lower(), set.upper());

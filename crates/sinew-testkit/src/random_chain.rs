@@ -345,10 +345,17 @@ impl RandomChain {
     /// the anchor), and ends at its anchor on `link{i+1}`. Every hole has a random z
     /// (±5 mm, never 0) on a circle of radius 15–25 mm.
     pub fn explicit_spec(&self, seed: u64) -> RoutingSpec {
+        self.explicit_spec_with(seed, 3)
+    }
+
+    /// [`RandomChain::explicit_spec`] with `per_joint` cables per universal joint (3 gives the
+    /// same routing): four or more make the equilibrium set of each joint two-dimensional or
+    /// more, the sets the tension policies choose in.
+    pub fn explicit_spec_with(&self, seed: u64, per_joint: usize) -> RoutingSpec {
         let mut rng = rng(seed);
         let mut cables = Vec::new();
         for i in 0..self.joints {
-            for k in 0..3 {
+            for k in 0..per_joint {
                 let mut holes = vec![random_hole("base_link".to_owned(), &mut rng)];
                 for j in 1..=i {
                     for link in [format!("cross{j}"), format!("link{j}"), format!("link{j}_distal")]
