@@ -129,8 +129,14 @@ fn bench_plans(c: &mut Criterion) {
     for objective in [Objective::StiffnessAlong(Vector3::y()), Objective::MinStiffness] {
         for (method, label) in methods {
             let settings = PlanSettings { method, ..PlanSettings::default() };
-            let plan =
-                planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+            // The bundle's clarabel LPs can lose their accuracy on this chain: said, not timed.
+            let plan = match planner.plan(&mut data, &q, &f0, objective, &requirements, &settings) {
+                Ok(plan) => plan,
+                Err(e) => {
+                    println!("chain 25 decoupled {} {label}: no plan ({e})", objective.name());
+                    continue;
+                }
+            };
             println!(
                 "chain 25 decoupled {} {label}: {} iterations, value {:.9e}, gap {:.1e}",
                 objective.name(),
@@ -142,7 +148,7 @@ fn bench_plans(c: &mut Criterion) {
                 b.iter(|| {
                     planner
                         .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
-                        .unwrap()
+                        .is_ok()
                 })
             });
         }
