@@ -255,3 +255,21 @@ def sweep(
     lower: Optional[float] = None,
     upper: Optional[float] = None,
 ) -> SweepResult: ...
+def to_mjcf(
+    robot: Robot,
+    routing: Routing,
+    q: ArrayLike,
+    tensions: ArrayLike,
+    wrench: Optional[ArrayLike] = None,
+    *,
+    cables: str = "springs",
+    split: Optional[str] = None,
+    damping: float = 0.05,
+) -> str:
+    """The MJCF text of the robot at ``q`` held by ``tensions`` (N, routing order); ``cables``
+    "springs" or "motors", ``split="segments"`` for one spring per segment. Apply ``-wrench``
+    at site ``tip`` to hold the pose."""
+    ...
+def cable_geometry(robot: Robot, routing: Routing, q: ArrayLike) -> tuple[F64, F64]:
+    """``(lengths, j_c)`` at ``q``: the cable lengths (m) and ``J_c = dL/dQ`` (cables x dof)."""
+    ...
