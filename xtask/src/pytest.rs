@@ -1,6 +1,6 @@
 //! `cargo xtask test [--locked]`: every test of the project in one command. `cargo test
 //! --workspace`, then the Python bindings: a virtualenv in `target/py-venv` (made once; pip
-//! installs numpy and pytest into it), the package assembled in `target/py-pkg/sinew` from
+//! installs numpy, pytest and mujoco into it), the package assembled in `target/py-pkg/sinew` from
 //! `crates/sinew-py/python/sinew` and the extension module `cargo test` has just built (the
 //! `sinew-py` cdylib, `target/debug/deps/lib_sinew.so`: its example links the library, so the
 //! workspace build makes it with the workspace's features and nothing is compiled again), and
@@ -15,8 +15,9 @@ use std::time::Instant;
 
 use crate::DynResult;
 
-/// What pip installs into the virtualenv: the tests' dependencies only.
-const PYTHON_PACKAGES: [&str; 2] = ["numpy", "pytest"];
+/// What pip installs into the virtualenv: the tests' dependencies only (mujoco: the exported
+/// MJCF models are checked by the simulator, `crates/sinew-py/tests/test_mujoco.py`).
+const PYTHON_PACKAGES: [&str; 3] = ["numpy", "pytest", "mujoco"];
 
 pub fn run(root: &Path, args: &[String]) -> DynResult<()> {
     let mut locked = false;

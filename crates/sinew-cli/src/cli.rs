@@ -117,7 +117,7 @@ pub struct MjcfArgs {
     /// One spring tendon per segment between holes instead of one per cable.
     #[arg(long, value_enum)]
     pub split: Option<SplitAs>,
-    /// Damping of every hinge, N m s/rad (default 0.05).
+    /// Damping of every hinge, N m s/rad (default 1, near critical for cdhrm5).
     #[arg(long, value_name = "N·m·s/rad", allow_hyphen_values = true)]
     pub damping: Option<String>,
     /// Ignore gravity (zero gravity vector instead of robot.toml's, in the model too).

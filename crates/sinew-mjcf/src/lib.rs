@@ -85,11 +85,14 @@ pub struct MjcfOptions {
     pub timestep: f64,
 }
 
-/// The default joint damping, N m s/rad: settles cdhrm5 in about a second of simulated time.
-pub const DEFAULT_DAMPING: f64 = 0.05;
+/// The default joint damping, N m s/rad: near critical for cdhrm5's slowest mode at E4 (about
+/// 1 rad/s), so a pushed arm settles to 1e-4 of its static deflection within 12 s of simulated
+/// time (measured by `crates/sinew-py/tests/test_mujoco.py`); small damping rings for minutes.
+pub const DEFAULT_DAMPING: f64 = 1.0;
 
-/// The default time step, s.
-pub const DEFAULT_TIMESTEP: f64 = 1e-3;
+/// The default time step, s: stable with the default integrator (implicitfast) on the stiffest
+/// joints of the repository's robots.
+pub const DEFAULT_TIMESTEP: f64 = 2e-3;
 
 impl Default for MjcfOptions {
     fn default() -> MjcfOptions {

@@ -264,7 +264,7 @@ def to_mjcf(
     *,
     cables: str = "springs",
     split: Optional[str] = None,
-    damping: float = 0.05,
+    damping: float = 1.0,
 ) -> str:
     """The MJCF text of the robot at ``q`` held by ``tensions`` (N, routing order); ``cables``
     "springs" or "motors", ``split="segments"`` for one spring per segment. Apply ``-wrench``
