@@ -51,7 +51,7 @@ mod tests {
 
     #[test]
     fn numbers_read_back_exactly() {
-        for x in [0.1, -0.5235987755982989, 1e-12, 3.0, 2.0f64.sqrt() * 1e7, -0.0] {
+        for x in [0.1, -std::f64::consts::FRAC_PI_6, 1e-12, 3.0, 2.0f64.sqrt() * 1e7, -0.0] {
             assert_eq!(num(x).parse::<f64>().ok(), Some(x), "{}", num(x));
         }
         assert_eq!(nums(&[1.0, 0.25]), "1.0 0.25");
