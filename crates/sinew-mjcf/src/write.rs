@@ -321,3 +321,23 @@ fn sites(s: &mut String, robot: &Robot, routing: &Routing, body: usize, depth: u
         let _ = writeln!(s, "{pad}<site name=\"tip\" pos=\"{}\"/>", vec3(&tip.point));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::spring_length;
+
+    #[test]
+    fn the_spring_length_gives_the_tension_and_never_pushes() {
+        // L_u = 0.03 − 20/3027 > 0: the dead band [0, L_u].
+        let [lo, hi] = spring_length(0.03, 20.0, 3027.0);
+        assert_eq!(lo, 0.0);
+        assert!((3027.0 * (0.03 - hi) - 20.0).abs() < 1e-12);
+        // 300 N on the same crossing: L_u < 0, written L_u L_u.
+        let [lo, hi] = spring_length(0.03, 300.0, 3027.0);
+        assert!(lo < 0.0 && lo == hi);
+        assert!((3027.0 * (0.03 - hi) - 300.0).abs() < 1e-12);
+        // Exactly −1 is MuJoCo's "compute it": the next float below instead.
+        let [lo, hi] = spring_length(1.0, 2.0, 1.0);
+        assert!(lo == hi && lo < -1.0 && lo > -1.0 - 1e-15);
+    }
+}
