@@ -1,6 +1,6 @@
 //! `cargo xtask test [--locked]`: every test of the project in one command. `cargo test
 //! --workspace`, then the Python bindings: a virtualenv in `target/py-venv` (made once; pip
-//! installs numpy, pytest, dask[array] and distributed into it), the package assembled in
+//! installs numpy, pytest, mujoco, dask[array] and distributed into it), the package assembled in
 //! `target/py-pkg/sinew` from `crates/sinew-py/python/sinew` and the extension module `cargo
 //! test` has just built (the `sinew-py` cdylib, `target/debug/deps/lib_sinew.so`: its example
 //! links the library, so the workspace build makes it with the workspace's features and
@@ -17,9 +17,10 @@ use std::time::Instant;
 
 use crate::DynResult;
 
-/// What pip installs into the virtualenv: the tests' dependencies only (dask's for the
-/// `sinew.dask` tests: a two-worker LocalCluster).
-const PYTHON_PACKAGES: [&str; 4] = ["numpy", "pytest", "dask[array]", "distributed"];
+/// What pip installs into the virtualenv: the tests' dependencies only (mujoco: the exported
+/// MJCF models are checked by the simulator, `crates/sinew-py/tests/test_mujoco.py`; dask's for
+/// the `sinew.dask` tests: a two-worker LocalCluster).
+const PYTHON_PACKAGES: [&str; 5] = ["numpy", "pytest", "mujoco", "dask[array]", "distributed"];
 
 /// Cargo's target folder: `$CARGO_TARGET_DIR` (relative to the workspace) or `target/`.
 fn target_dir(root: &Path) -> std::path::PathBuf {

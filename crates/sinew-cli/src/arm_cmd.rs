@@ -5,9 +5,9 @@ use serde::Serialize;
 use sinew::statics::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 
-use crate::cli::ArmArgs;
+use crate::cli::{ArmArgs, TensionArgs};
 use crate::error::{CliError, library_error};
-use crate::input::{load, numbers_n, to_radians};
+use crate::input::{load, numbers_n, pose, wrench};
 use crate::output::{
     Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, na_vec, print_json,
     q_labels,
@@ -88,44 +88,38 @@ struct EllipsoidOut {
     lambda_min: f64,
 }
 
+/// `--levels`, one per joint, if given. Levels outside [0, 1] are the library's to refuse
+/// (`--levels: joint i: …`).
+pub fn levels(args: &TensionArgs, joints: usize) -> Result<Option<Vec<f64>>, CliError> {
+    let what = format!("tension levels (one per joint, {joints} joints)");
+    args.levels.as_deref().map(|text| numbers_n("--levels", text, joints, &what)).transpose()
+}
+
+/// The tensions the options choose: `--levels` (as parsed by [`levels`]), `--policy`, or the
+/// default.
+pub fn tension_choice<'a>(levels: Option<&'a [f64]>, args: &TensionArgs) -> TensionChoice<'a> {
+    match (levels, args.policy) {
+        (Some(levels), _) => TensionChoice::Levels(levels),
+        (None, Some(policy)) => TensionChoice::Policy(policy.tension_policy()),
+        (None, None) => TensionChoice::Default,
+    }
+}
+
 /// Run `sinew arm`.
 pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
-    let dof = robot.dof();
     let joints = robot.joint_count();
-    let mut q = numbers_n(
-        "--q",
-        &args.q,
-        dof,
-        &format!("angles (one per revolute joint, {joints} joints)"),
-    )?;
-    to_radians(&mut q, args.deg);
-    let wrench = match &args.wrench {
-        Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
-        None => vec![0.0; 6],
-    };
+    let q = pose(&args.q, args.deg, robot)?;
+    let wrench = wrench(args.wrench.as_deref())?;
     let arm = ArmStiffness::new(robot, routing).map_err(library_error)?.checking_limits();
     let mut data = ArmStiffnessData::new(&arm);
     let f0 = Vector6::from_column_slice(&wrench);
     // The pose stage (angles outside the limits refused, `--q: …`), once.
     arm.set_pose(&mut data, &q, &f0).map_err(library_error)?;
-    // Levels outside [0, 1] are the library's to refuse (`--levels: joint i: …`).
-    let levels = match &args.levels {
-        Some(text) => Some(numbers_n(
-            "--levels",
-            text,
-            joints,
-            &format!("tension levels (one per joint, {joints} joints)"),
-        )?),
-        None => None,
-    };
-    let by_default = levels.is_none() && args.policy.is_none();
-    let choice = match (&levels, args.policy) {
-        (Some(levels), _) => TensionChoice::Levels(levels),
-        (None, Some(policy)) => TensionChoice::Policy(policy.tension_policy()),
-        (None, None) => TensionChoice::Default,
-    };
+    let levels = levels(&args.tensions, joints)?;
+    let choice = tension_choice(levels.as_deref(), &args.tensions);
+    let by_default = levels.is_none() && args.tensions.policy.is_none();
     arm.set_tensions(&mut data, choice).map_err(library_error)?;
     let chosen = data.statics.chosen();
     // The default in closed form is every joint at level 0.

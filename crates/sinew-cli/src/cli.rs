@@ -59,6 +59,76 @@ pub enum Command {
     /// Write a Sinew robot folder from another tool's model files.
     #[command(subcommand)]
     Import(ImportSource),
+    /// Write the robot, its cables and chosen tensions in another tool's format.
+    #[command(subcommand)]
+    Export(ExportTarget),
+}
+
+/// The formats `sinew export` writes.
+#[derive(Debug, Subcommand)]
+pub enum ExportTarget {
+    /// A MuJoCo model (MJCF) of the robot at the pose, its cables holding it with the tensions
+    /// that `sinew arm` (--levels, --policy) or `sinew plan` (--plan OBJECTIVE) chooses.
+    ///
+    /// Springs (K_l and a spring length giving each tension at the pose) or motors (the
+    /// tensions as ctrl, gear -1), optionally one spring per segment (--split segments). The
+    /// load is not in the model: apply −F0 at site `tip`. Nothing is written on any error.
+    Mjcf(MjcfArgs),
+}
+
+/// How the cables enter the MJCF model (`--cables`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CablesAs {
+    /// Elastic tendons: the whole joint stiffness (controllable + inherent).
+    Springs,
+    /// Inextensible tendons pulled by motors: the controllable part alone.
+    Motors,
+}
+
+/// `--split`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SplitAs {
+    /// One spring tendon per segment between holes (the stick model; springs only).
+    Segments,
+}
+
+/// `sinew export mjcf`.
+#[derive(Debug, Args)]
+pub struct MjcfArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// The pose: one angle per revolute joint, base first (rad; degrees with --deg).
+    #[arg(long, value_name = "Q1,...,Qd", allow_hyphen_values = true)]
+    pub q: String,
+    /// F0, the wrench the end-effector exerts, base frame: FX,FY,FZ,MX,MY,MZ (N, N m).
+    /// Default zero.
+    #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
+    pub wrench: Option<String>,
+    #[command(flatten)]
+    pub tensions: TensionArgs,
+    /// Plan the tensions instead, as `sinew plan --objective OBJECTIVE` with the plan options.
+    #[arg(long, value_enum, value_name = "OBJECTIVE", conflicts_with_all = ["levels", "policy"])]
+    pub plan: Option<PlanObjective>,
+    #[command(flatten)]
+    pub options: PlanOptions,
+    /// Cables as springs (default) or as motors.
+    #[arg(long, value_enum, default_value_t = CablesAs::Springs)]
+    pub cables: CablesAs,
+    /// One spring tendon per segment between holes instead of one per cable.
+    #[arg(long, value_enum)]
+    pub split: Option<SplitAs>,
+    /// Damping of every hinge, N m s/rad (default 1, near critical for cdhrm5).
+    #[arg(long, value_name = "N·m·s/rad", allow_hyphen_values = true)]
+    pub damping: Option<String>,
+    /// Ignore gravity (zero gravity vector instead of robot.toml's, in the model too).
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Read --q in degrees (the file is in radians).
+    #[arg(long)]
+    pub deg: bool,
+    /// The MJCF file to write.
+    #[arg(long, value_name = "FILE.xml")]
+    pub out: PathBuf,
 }
 
 /// The tools `sinew import` reads.
@@ -216,6 +286,19 @@ pub struct ArmArgs {
     /// FX,FY,FZ,MX,MY,MZ (N, N m). Default zero.
     #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
     pub wrench: Option<String>,
+    #[command(flatten)]
+    pub tensions: TensionArgs,
+    /// Ignore gravity (zero gravity vector instead of robot.toml's).
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Read --q in degrees (the output stays in radians).
+    #[arg(long)]
+    pub deg: bool,
+}
+
+/// How `sinew arm` and `sinew export mjcf` choose the tensions: levels or a policy.
+#[derive(Debug, Args)]
+pub struct TensionArgs {
     /// Tension level of each joint in [0, 1] along its feasible interval (0: least total
     /// tension, 1: most), S1,...,Sn base first: the paper's closed form, for three cables per
     /// universal joint. Default all 0 where it applies, else `--policy least-total`.
@@ -225,12 +308,38 @@ pub struct ArmArgs {
     /// cable set): least total tension, least 2-norm, or farthest from the limits.
     #[arg(long, value_enum)]
     pub policy: Option<Policy>,
-    /// Ignore gravity (zero gravity vector instead of robot.toml's).
-    #[arg(long)]
-    pub no_gravity: bool,
-    /// Read --q in degrees (the output stays in radians).
-    #[arg(long)]
-    pub deg: bool,
+}
+
+/// What a plan requires beyond its objective (`sinew plan`, `sinew export mjcf --plan`).
+#[derive(Debug, Args)]
+pub struct PlanOptions {
+    /// The direction of stiffness-along and compliance-along: UX,UY,UZ (base frame, any
+    /// non-zero length: it is normalised).
+    #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
+    pub direction: Option<String>,
+    /// Require the smallest eigenvalue of K_fd to be at least this (N/m).
+    #[arg(long, value_name = "N/m", allow_hyphen_values = true)]
+    pub k_min: Option<String>,
+    /// Require K_fd ⪰ K_des: nine numbers, row by row, symmetric positive definite (N/m).
+    #[arg(long, value_name = "K11,...,K33", allow_hyphen_values = true)]
+    pub k_des: Option<String>,
+    /// Stability margin: smallest eigenvalue of K_q + K_W at least this (N m/rad, > 0).
+    #[arg(long, value_name = "N·m/rad", allow_hyphen_values = true)]
+    pub margin: Option<String>,
+    /// Total tension at most this (N).
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub budget: Option<String>,
+    /// The tensions of joint J's own cables sum to at most N (joints numbered from 1);
+    /// repeat for several joints.
+    #[arg(long, value_name = "J:N", allow_hyphen_values = true)]
+    pub joint_budget: Vec<String>,
+    /// Hold joint J at tension level S in [0, 1] (joints numbered from 1; the paper's levels,
+    /// decoupled model); repeatable.
+    #[arg(long, value_name = "J:S", allow_hyphen_values = true)]
+    pub fixed_level: Vec<String>,
+    /// Stop when the certified gap is at most this fraction of the value (default 1e-6).
+    #[arg(long, value_name = "REL", allow_hyphen_values = true)]
+    pub gap: Option<String>,
 }
 
 /// What `sinew plan` optimises.
@@ -263,33 +372,8 @@ pub struct PlanArgs {
     /// What to optimise.
     #[arg(long, value_enum)]
     pub objective: PlanObjective,
-    /// The direction of stiffness-along and compliance-along: UX,UY,UZ (base frame, any
-    /// non-zero length: it is normalised).
-    #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
-    pub direction: Option<String>,
-    /// Require the smallest eigenvalue of K_fd to be at least this (N/m).
-    #[arg(long, value_name = "N/m", allow_hyphen_values = true)]
-    pub k_min: Option<String>,
-    /// Require K_fd ⪰ K_des: nine numbers, row by row, symmetric positive definite (N/m).
-    #[arg(long, value_name = "K11,...,K33", allow_hyphen_values = true)]
-    pub k_des: Option<String>,
-    /// Stability margin: smallest eigenvalue of K_q + K_W at least this (N m/rad, > 0).
-    #[arg(long, value_name = "N·m/rad", allow_hyphen_values = true)]
-    pub margin: Option<String>,
-    /// Total tension at most this (N).
-    #[arg(long, value_name = "N", allow_hyphen_values = true)]
-    pub budget: Option<String>,
-    /// The tensions of joint J's own cables sum to at most N (joints numbered from 1);
-    /// repeat for several joints.
-    #[arg(long, value_name = "J:N", allow_hyphen_values = true)]
-    pub joint_budget: Vec<String>,
-    /// Hold joint J at tension level S in [0, 1] (joints numbered from 1; the paper's levels,
-    /// decoupled model); repeatable.
-    #[arg(long, value_name = "J:S", allow_hyphen_values = true)]
-    pub fixed_level: Vec<String>,
-    /// Stop when the certified gap is at most this fraction of the value (default 1e-6).
-    #[arg(long, value_name = "REL", allow_hyphen_values = true)]
-    pub gap: Option<String>,
+    #[command(flatten)]
+    pub options: PlanOptions,
     /// Ignore gravity (zero gravity vector instead of robot.toml's).
     #[arg(long)]
     pub no_gravity: bool,

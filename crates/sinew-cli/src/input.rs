@@ -127,3 +127,20 @@ pub fn to_radians(values: &mut [f64], deg: bool) {
         }
     }
 }
+
+/// `--q`: one angle per revolute joint (degrees with `--deg`), in radians.
+pub fn pose(text: &str, deg: bool, robot: &Robot) -> Result<Vec<f64>, CliError> {
+    let (dof, joints) = (robot.dof(), robot.joint_count());
+    let what = format!("angles (one per revolute joint, {joints} joints)");
+    let mut q = numbers_n("--q", text, dof, &what)?;
+    to_radians(&mut q, deg);
+    Ok(q)
+}
+
+/// `--wrench`: six components, zero when not given.
+pub fn wrench(text: Option<&str>) -> Result<Vec<f64>, CliError> {
+    match text {
+        Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)"),
+        None => Ok(vec![0.0; 6]),
+    }
+}

@@ -6,7 +6,8 @@
 //! - `sinew arm`: T0, tensions, K_q, K_W, C_x, K_x, K_fd, the ellipsoid and stability;
 //! - `sinew sweep`: a joint's min/max stiffness maps over its angles (Fig. 5);
 //! - `sinew plan`: the tensions that optimise the end stiffness, certified by a gap;
-//! - `sinew import caspr`: a robot folder from a CASPR model's XML files.
+//! - `sinew import caspr`: a robot folder from a CASPR model's XML files;
+//! - `sinew export mjcf`: the robot, its cables and chosen tensions as a MuJoCo model.
 //!
 //! Errors print one line, `sinew: <message>`, on standard error and exit with 2 (bad input)
 //! or 1 (the model has no answer, e.g. an infeasible load); never a panic.
@@ -14,6 +15,7 @@
 mod arm_cmd;
 mod cli;
 mod error;
+mod export_cmd;
 mod import_cmd;
 mod input;
 mod joint_cmd;
@@ -26,7 +28,7 @@ use std::process::ExitCode;
 
 use clap::Parser as _;
 
-use crate::cli::{Cli, Command, ImportSource};
+use crate::cli::{Cli, Command, ExportTarget, ImportSource};
 use crate::error::CliError;
 
 fn run(cli: &Cli) -> Result<(), CliError> {
@@ -37,6 +39,7 @@ fn run(cli: &Cli) -> Result<(), CliError> {
         Command::Sweep(args) => sweep_cmd::run(args),
         Command::Plan(args) => plan_cmd::run(args),
         Command::Import(ImportSource::Caspr(args)) => import_cmd::caspr(args),
+        Command::Export(ExportTarget::Mjcf(args)) => export_cmd::mjcf(args),
     }
 }
 

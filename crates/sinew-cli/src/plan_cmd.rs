@@ -7,9 +7,9 @@ use sinew::planner::{
 };
 use sinew::stiffness::ArmStiffness;
 
-use crate::cli::{PlanArgs, PlanObjective};
+use crate::cli::{PlanArgs, PlanObjective, PlanOptions};
 use crate::error::{CliError, library_error};
-use crate::input::{load, numbers_n, one_number, to_radians};
+use crate::input::{load, numbers_n, one_number, pose, wrench};
 use crate::output::{Fmt, Rows, Table, cartesian_labels, emit, matrix, na_rows, print_json};
 
 /// The JSON document of `sinew plan`.
@@ -69,18 +69,30 @@ fn joint_pairs(
         .collect()
 }
 
-/// Run `sinew plan`.
-pub fn run(args: &PlanArgs) -> Result<(), CliError> {
-    let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
-    let (robot, routing) = (&loaded.robot, &loaded.routing);
-    let dof = robot.dof();
-    let mut q = numbers_n("--q", &args.q, dof, &format!("angles (one per revolute joint, {dof})"))?;
-    to_radians(&mut q, args.deg);
-    let wrench = match &args.wrench {
-        Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)")?,
-        None => vec![0.0; 6],
-    };
-    let direction = match &args.direction {
+/// What a plan is asked: the objective and its direction, the requirements, the gap.
+#[derive(Debug)]
+pub struct PlanRequest {
+    /// The objective (with its unit direction).
+    pub objective: Objective,
+    /// `--direction`, normalised.
+    pub direction: Option<Vector3<f64>>,
+    /// Margin, budgets, floors, held levels.
+    pub requirements: Requirements,
+    /// `--gap`.
+    pub tolerance: f64,
+    /// The settings with that gap.
+    pub settings: PlanSettings,
+}
+
+/// The plan `objective` and `options` ask for, every number checked as `sinew plan` does.
+///
+/// `flag` is the option that named the objective (`--objective`, or `--plan` for the export).
+pub fn request(
+    flag: &str,
+    objective: PlanObjective,
+    options: &PlanOptions,
+) -> Result<PlanRequest, CliError> {
+    let direction = match &options.direction {
         Some(text) => {
             let u = numbers_n("--direction", text, 3, "components (UX,UY,UZ)")?;
             let u = Vector3::new(u[0], u[1], u[2]);
@@ -93,9 +105,9 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         None => None,
     };
     let need_direction = |what: &str| {
-        direction.ok_or_else(|| CliError::input(format!("--objective {what} needs --direction")))
+        direction.ok_or_else(|| CliError::input(format!("{flag} {what} needs --direction")))
     };
-    let objective = match args.objective {
+    let objective = match objective {
         PlanObjective::StiffnessAlong => {
             Objective::StiffnessAlong(need_direction("stiffness-along")?)
         }
@@ -106,7 +118,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         PlanObjective::Volume => Objective::Volume,
         PlanObjective::LeastTension => Objective::LeastTension,
     };
-    let k_des = match &args.k_des {
+    let k_des = match &options.k_des {
         Some(text) => {
             let k = numbers_n("--k-des", text, 9, "entries (K11,...,K33, row by row)")?;
             Some(Matrix3::from_row_slice(&k))
@@ -115,32 +127,43 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     };
     let joint_budgets = joint_pairs(
         "--joint-budget",
-        &args.joint_budget,
+        &options.joint_budget,
         "J:N, a joint numbered from 1 and a total tension in N",
     )?;
     let fixed_levels = joint_pairs(
         "--fixed-level",
-        &args.fixed_level,
+        &options.fixed_level,
         "J:S, a joint numbered from 1 and a level in [0, 1]",
     )?;
     let requirements = Requirements {
         joint_budgets,
         fixed_levels,
-        margin: args
+        margin: options
             .margin
             .as_deref()
             .map(|t| one_number("--margin", t))
             .transpose()?
             .unwrap_or(DEFAULT_MARGIN),
-        budget: args.budget.as_deref().map(|t| one_number("--budget", t)).transpose()?,
-        k_min: args.k_min.as_deref().map(|t| one_number("--k-min", t)).transpose()?,
+        budget: options.budget.as_deref().map(|t| one_number("--budget", t)).transpose()?,
+        k_min: options.k_min.as_deref().map(|t| one_number("--k-min", t)).transpose()?,
         k_des,
     };
-    let tolerance = match &args.gap {
+    let tolerance = match &options.gap {
         Some(text) => one_number("--gap", text)?,
         None => DEFAULT_GAP,
     };
     let settings = PlanSettings { relative_gap: tolerance, ..PlanSettings::default() };
+    Ok(PlanRequest { objective, direction, requirements, tolerance, settings })
+}
+
+/// Run `sinew plan`.
+pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+    let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
+    let (robot, routing) = (&loaded.robot, &loaded.routing);
+    let q = pose(&args.q, args.deg, robot)?;
+    let wrench = wrench(args.wrench.as_deref())?;
+    let PlanRequest { objective, direction, requirements, tolerance, settings } =
+        request("--objective", args.objective, &args.options)?;
     // The planner's one pose stage refuses angles outside the limits (`--q: …`).
     let arm = ArmStiffness::new(robot, routing).map_err(library_error)?.checking_limits();
     let planner = Planner::new(arm);

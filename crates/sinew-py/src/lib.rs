@@ -12,6 +12,7 @@ mod arm;
 pub mod batch;
 mod convert;
 mod errors;
+mod export;
 mod indicators;
 mod lazy;
 mod model;
@@ -49,6 +50,8 @@ fn _sinew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(indicators::joint_range, m)?)?;
     m.add_function(wrap_pyfunction!(indicators::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(pool_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(export::to_mjcf, m)?)?;
+    m.add_function(wrap_pyfunction!(export::cable_geometry, m)?)?;
     m.add("SinewError", py.get_type::<errors::SinewError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;
     m.add("InfeasibleError", py.get_type::<errors::InfeasibleError>())?;

@@ -73,3 +73,8 @@ __all__ = [
     "load_routing",
     "sweep",
 ]
+
+# The MuJoCo export (crate sinew-mjcf) and the cable geometry it is checked against.
+from ._sinew import cable_geometry, to_mjcf  # noqa: E402
+
+__all__ += ["cable_geometry", "to_mjcf"]

@@ -357,3 +357,21 @@ def sweep(
     upper: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> SweepResult: ...
+def to_mjcf(
+    robot: Robot,
+    routing: Routing,
+    q: ArrayLike,
+    tensions: ArrayLike,
+    wrench: Optional[ArrayLike] = None,
+    *,
+    cables: str = "springs",
+    split: Optional[str] = None,
+    damping: float = 1.0,
+) -> str:
+    """The MJCF text of the robot at ``q`` held by ``tensions`` (N, routing order); ``cables``
+    "springs" or "motors", ``split="segments"`` for one spring per segment. Apply ``-wrench``
+    at site ``tip`` to hold the pose."""
+    ...
+def cable_geometry(robot: Robot, routing: Routing, q: ArrayLike) -> tuple[F64, F64]:
+    """``(lengths, j_c)`` at ``q``: the cable lengths (m) and ``J_c = dL/dQ`` (cables x dof)."""
+    ...
