@@ -363,12 +363,29 @@ pub struct PlanArgs {
     #[command(flatten)]
     pub common: Common,
     /// The pose: one angle per revolute joint, base first (rad; degrees with --deg).
-    #[arg(long, value_name = "Q1,...,Qd", allow_hyphen_values = true)]
-    pub q: String,
+    #[arg(
+        long,
+        value_name = "Q1,...,Qd",
+        allow_hyphen_values = true,
+        required_unless_present = "trajectory"
+    )]
+    pub q: Option<String>,
     /// F0, the wrench the end-effector exerts, base frame: FX,FY,FZ,MX,MY,MZ (N, N m). The
     /// moment must be zero. Default zero.
     #[arg(long, value_name = "FX,FY,FZ,MX,MY,MZ", allow_hyphen_values = true)]
     pub wrench: Option<String>,
+    /// Plan along a trajectory instead of at --q: a CSV file, one row per step, the angles
+    /// then optionally the six F0 components (else --wrench for every step); `#` comments and
+    /// a header line allowed. Each step is warm-started from the one before; the rows come out
+    /// as CSV (or JSON with --json).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "q")]
+    pub trajectory: Option<PathBuf>,
+    /// Along a trajectory: the largest rate of change of any cable's tension (N/s), with --dt.
+    #[arg(long, value_name = "N/s", allow_hyphen_values = true, requires_all = ["trajectory", "dt"])]
+    pub rate: Option<String>,
+    /// Along a trajectory: the time between two steps (s), with --rate.
+    #[arg(long, value_name = "s", allow_hyphen_values = true, requires_all = ["trajectory", "rate"])]
+    pub dt: Option<String>,
     /// What to optimise.
     #[arg(long, value_enum)]
     pub objective: PlanObjective,

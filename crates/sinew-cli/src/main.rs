@@ -23,6 +23,7 @@ mod output;
 mod plan_cmd;
 mod routing_cmd;
 mod sweep_cmd;
+mod trajectory_cmd;
 
 use std::process::ExitCode;
 
@@ -37,6 +38,7 @@ fn run(cli: &Cli) -> Result<(), CliError> {
         Command::Joint(args) => joint_cmd::run(args),
         Command::Arm(args) => arm_cmd::run(args),
         Command::Sweep(args) => sweep_cmd::run(args),
+        Command::Plan(args) if args.trajectory.is_some() => trajectory_cmd::run(args),
         Command::Plan(args) => plan_cmd::run(args),
         Command::Import(ImportSource::Caspr(args)) => import_cmd::caspr(args),
         Command::Export(ExportTarget::Mjcf(args)) => export_cmd::mjcf(args),

@@ -160,7 +160,8 @@ pub fn request(
 pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
-    let q = pose(&args.q, args.deg, robot)?;
+    // (clap requires --q without --trajectory; main.rs sends --trajectory elsewhere.)
+    let q = pose(args.q.as_deref().unwrap_or_default(), args.deg, robot)?;
     let wrench = wrench(args.wrench.as_deref())?;
     let PlanRequest { objective, direction, requirements, tolerance, settings } =
         request("--objective", args.objective, &args.options)?;

@@ -14,8 +14,9 @@ use sinew_testkit::cdhrm5;
 use crate::Planner;
 use crate::blocks::{base, margin_block};
 use crate::frame::Frame;
+use crate::program::{Block, Duals, End, Sdp, Settings, Smooth, bound_at};
 use crate::rows::linear_rows;
-use crate::sdp::{self, Block, Duals, End, Sdp, Settings, Smooth};
+use crate::sdp;
 use crate::smooth::{EndObjective, Kind};
 
 fn frame(model: PatternModel) -> Frame {
@@ -136,7 +137,7 @@ fn the_certificate_bounds_every_sampled_feasible_value_for_random_multipliers() 
         for trial in 0..20 {
             let centre = &points[trial];
             let duals = random_duals(&sdp, &mut rng);
-            let upper = sdp::bound_at(
+            let upper = bound_at(
                 &sdp,
                 centre,
                 linear(centre),
@@ -145,7 +146,7 @@ fn the_certificate_bounds_every_sampled_feasible_value_for_random_multipliers() 
             )
             .unwrap();
             let (v, g, _) = evaluate(&mut objective, centre);
-            let upper_smooth = sdp::bound_at(&sdp, centre, v, &g, &duals).unwrap();
+            let upper_smooth = bound_at(&sdp, centre, v, &g, &duals).unwrap();
             assert!(upper.is_finite() && upper_smooth.is_finite());
             for x in &points {
                 assert!(

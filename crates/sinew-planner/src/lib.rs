@@ -49,6 +49,7 @@ mod pencil;
 mod phases;
 mod plan;
 mod problem;
+mod program;
 mod rows;
 mod sdp;
 mod smooth;

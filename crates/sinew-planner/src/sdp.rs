@@ -1,12 +1,10 @@
-//! A small primal–dual interior-point method for a concave objective under linear rows and
-//! linear matrix inequalities, with Mehrotra's predictor–corrector and the HKM direction, and
-//! the method-independent certificate of every iterate.
+//! A small primal–dual interior-point method for the problems of [`crate::program`], with
+//! Mehrotra's predictor–corrector and the HKM direction, certified at every iterate by
+//! [`crate::program::upper_bound`].
 //!
 //! # Math
-//! Maximise `φ(x) = c₀ + cᵀx + ψ(x)` (`ψ` smooth and concave, or absent) subject to
-//! `s = h − G x ≥ 0` (multipliers `y`) and `S_j = F_j(x) = F_j0 + Σ_a x_a F_ja ⪰ 0`
-//! (multipliers `Z_j`). With `μ = (sᵀy + Σ⟨S_j, Z_j⟩)/ν`, `ν = rows + Σ n_j`, the Newton
-//! step towards the central point `s∘y = σμ`, `S Z = σμ I` (symmetrised as HKM does:
+//! With `μ = (sᵀy + Σ⟨S_j, Z_j⟩)/ν`, `ν = rows + Σ n_j`, the Newton step towards the central
+//! point `s∘y = σμ`, `S Z = σμ I` (symmetrised as HKM does:
 //! `ΔZ = σμ S⁻¹ − Z − sym(Z ΔS S⁻¹)`) reduces to the Schur system
 //!
 //! ```text
@@ -19,128 +17,10 @@
 //! lengths are found by Cholesky trials, 95 % of the way to the boundary. The primal iterate
 //! stays strictly feasible (every phase starts from such a point), so `s` and `S` are functions
 //! of `x`.
-//!
-//! **Certificate.** For any `y ≥ 0`, `Z ⪰ 0`, the Lagrangian
-//! `L(x) = φ(x) + yᵀ(h − Gx) + Σ⟨Z_j, F_j(x)⟩` is concave and `≥ φ` on the feasible set, so with
-//! `r = ∇L(x̄) = ∇φ(x̄) − Gᵀy + F*(Z)` and a box `[lo, hi]` that holds an optimum,
-//!
-//! ```text
-//! UB = φ(x̄) + yᵀs + Σ⟨Z_j, S_j⟩ + Σ_a max(r_a (hi_a − x̄_a), r_a (lo_a − x̄_a))  ≥  max φ.
-//! ```
-//!
-//! An epigraph variable `t` (unbounded, in one block only, not in a row) has its block's `Z`
-//! scaled so that `r_t = 0` exactly. Nothing in the bound depends on how `y` and `Z` were found.
 
 use crate::dense::{cholesky, cholesky_inverse, cholesky_solve, inner, multiply};
-
-/// One matrix inequality `F(x) = F_0 + Σ_a x_a F_a ⪰ 0` (each n × n, row-major, symmetric).
-#[derive(Debug, Clone)]
-pub(crate) struct Block {
-    pub(crate) n: usize,
-    pub(crate) constant: Vec<f64>,
-    /// One per variable; `None` where the block does not depend on it.
-    pub(crate) coefficients: Vec<Option<Vec<f64>>>,
-}
-
-impl Block {
-    /// `F(x)` into `out`.
-    pub(crate) fn at(&self, x: &[f64], out: &mut [f64]) {
-        out.copy_from_slice(&self.constant);
-        for (xa, fa) in x.iter().zip(&self.coefficients) {
-            if let Some(fa) = fa {
-                for (o, f) in out.iter_mut().zip(fa) {
-                    *o += xa * f;
-                }
-            }
-        }
-    }
-}
-
-/// The problem: maximise `c₀ + cᵀx + ψ(x)` over rows and blocks; `[lo, hi]` bounds an optimum.
-#[derive(Debug, Clone)]
-pub(crate) struct Sdp {
-    pub(crate) c0: f64,
-    pub(crate) c: Vec<f64>,
-    /// `G`, rows × vars, row-major.
-    pub(crate) rows: Vec<f64>,
-    pub(crate) rhs: Vec<f64>,
-    pub(crate) blocks: Vec<Block>,
-    pub(crate) lo: Vec<f64>,
-    pub(crate) hi: Vec<f64>,
-    /// `(variable, block)` of an epigraph variable.
-    pub(crate) epigraph: Option<(usize, usize)>,
-}
-
-impl Sdp {
-    pub(crate) fn vars(&self) -> usize {
-        self.c.len()
-    }
-
-    fn row_count(&self) -> usize {
-        self.rhs.len()
-    }
-
-    /// `h − G x` into `s`.
-    pub(crate) fn slacks(&self, x: &[f64], s: &mut [f64]) {
-        let k = self.vars();
-        for (r, si) in s.iter_mut().enumerate() {
-            let g = &self.rows[r * k..r * k + k];
-            *si = self.rhs[r] - g.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
-        }
-    }
-}
-
-/// A smooth concave part `ψ` of the objective.
-pub(crate) trait Smooth {
-    /// `ψ(x)`, its gradient and its Hessian (vars × vars, ⪯ 0); `None` outside its domain.
-    fn evaluate(&mut self, x: &[f64], gradient: &mut [f64], hessian: &mut [f64]) -> Option<f64>;
-}
-
-/// How a run stops.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Settings {
-    /// Stop at `UB − φ ≤ relative_gap · max(|φ|, scale)`.
-    pub(crate) relative_gap: f64,
-    pub(crate) scale: f64,
-    pub(crate) max_iterations: usize,
-    /// Stop as soon as `φ ≥ target` (a feasibility phase) and `φ − target` is at least
-    /// `centring` of `UB − target` (so that the point is well inside, not on the target's
-    /// boundary), or at the optimum when it is above the target; or when `UB < target`.
-    pub(crate) target: Option<f64>,
-    pub(crate) centring: f64,
-}
-
-/// The multipliers `y` (rows) and `Z_j` (blocks).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Duals {
-    pub(crate) y: Vec<f64>,
-    pub(crate) z: Vec<Vec<f64>>,
-}
-
-/// How a run ended: the last iterate, its value, its certified bound, the iterations.
-#[derive(Debug, Clone)]
-pub(crate) struct Run {
-    pub(crate) x: Vec<f64>,
-    pub(crate) value: f64,
-    pub(crate) upper: f64,
-    pub(crate) iterations: usize,
-    pub(crate) end: End,
-}
-
-/// Why a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum End {
-    /// The gap closed.
-    Optimum,
-    /// `φ ≥ target`.
-    Reached,
-    /// `UB < target`.
-    Unreachable,
-    /// The iterations ran out.
-    NotConverged,
-    /// The iterate left the interior or the objective's domain (numerical breakdown).
-    Breakdown,
-}
+pub(crate) use crate::program::{Block, Duals, End, Run, Sdp, Settings, Smooth};
+use crate::program::{centred_duals, upper_bound};
 
 /// Per-block state of an iteration.
 struct BlockWork {
@@ -212,76 +92,6 @@ fn step_length(
         alpha *= 0.8;
     }
     0.0
-}
-
-/// The certified upper bound at `x` with `(y, Z)` (module docs); `z_scale` out: the factor of
-/// the epigraph block's `Z`.
-fn upper_bound(
-    sdp: &Sdp,
-    x: &[f64],
-    value: f64,
-    gradient: &[f64],
-    s: &[f64],
-    works: &[BlockWork],
-    duals: &Duals,
-) -> f64 {
-    let k = sdp.vars();
-    let mut scales = vec![1.0; sdp.blocks.len()];
-    let dual_term = |a: usize, j: usize, z: &[f64]| -> f64 {
-        sdp.blocks[j].coefficients[a].as_ref().map_or(0.0, |f| inner(f, z))
-    };
-    if let Some((t, j)) = sdp.epigraph {
-        let d = dual_term(t, j, &duals.z[j]);
-        let kappa = -gradient[t] / d;
-        if !(kappa.is_finite() && kappa > 0.0) {
-            return f64::INFINITY;
-        }
-        scales[j] = kappa;
-    }
-    let mut bound = value + duals.y.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
-    for (j, w) in works.iter().enumerate() {
-        bound += scales[j] * inner(&duals.z[j], &w.s);
-    }
-    for a in 0..k {
-        if sdp.epigraph.is_some_and(|(t, _)| t == a) {
-            continue;
-        }
-        let mut r = gradient[a];
-        for (row, y) in duals.y.iter().enumerate() {
-            r -= sdp.rows[row * k + a] * y;
-        }
-        for j in 0..sdp.blocks.len() {
-            r += scales[j] * dual_term(a, j, &duals.z[j]);
-        }
-        if r == 0.0 {
-            continue;
-        }
-        let term = (r * (sdp.hi[a] - x[a])).max(r * (sdp.lo[a] - x[a]));
-        if !term.is_finite() {
-            return f64::INFINITY;
-        }
-        bound += term;
-    }
-    bound
-}
-
-/// The certified bound at a strictly feasible `x` with any `y ≥ 0`, `Z ⪰ 0` (module docs),
-/// given `φ(x)` and `∇φ(x)`; `None` when `x` is not strictly feasible.
-#[cfg(test)]
-pub(crate) fn bound_at(
-    sdp: &Sdp,
-    x: &[f64],
-    value: f64,
-    gradient: &[f64],
-    duals: &Duals,
-) -> Option<f64> {
-    let mut s = vec![0.0; sdp.row_count()];
-    sdp.slacks(x, &mut s);
-    let mut works: Vec<BlockWork> = sdp.blocks.iter().map(|b| BlockWork::new(b.n)).collect();
-    for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
-        b.at(x, &mut w.s);
-    }
-    s.iter().all(|v| *v >= 0.0).then(|| upper_bound(sdp, x, value, gradient, &s, &works, duals))
 }
 
 /// Run the method from the strictly feasible `x0`, with multipliers centred there.
@@ -369,12 +179,14 @@ pub(crate) fn solve(
             return run(x0.to_vec(), value, upper, iteration, End::Breakdown);
         }
         if iteration == 0 {
-            duals = centred_duals(sdp, &gradient, &s, &works, value, settings.scale);
+            let inverses: Vec<&[f64]> = works.iter().map(|w| w.s_inv.as_slice()).collect();
+            duals = centred_duals(sdp, &gradient, &s, &inverses, value, settings.scale);
         }
         let mu = (duals.y.iter().zip(&s).map(|(a, b)| a * b).sum::<f64>()
             + works.iter().zip(&duals.z).map(|(w, z)| inner(z, &w.s)).sum::<f64>())
             / nu.max(1.0);
-        let upper = upper_bound(sdp, &x, value, &gradient, &s, &works, &duals);
+        let matrices: Vec<&[f64]> = works.iter().map(|w| w.s.as_slice()).collect();
+        let upper = upper_bound(sdp, &x, value, &gradient, &s, &matrices, &duals);
         best = Some((value, upper));
         if let Some(target) = settings.target {
             let converged =
@@ -589,63 +401,5 @@ fn directions(
         let g = &sdp.rows[r * k..r * k + k];
         ds[r] = -g.iter().zip(dx).map(|(a, b)| a * b).sum::<f64>();
         dy[r] = sigma_mu / s[r] - duals.y[r] - duals.y[r] / s[r] * ds[r];
-    }
-}
-
-/// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the
-/// least-squares fit of stationarity `∇φ + μ (−Gᵀ(1/s) + F*(S⁻¹)) = 0` (floored at a small
-/// positive value). An epigraph block gets its own `μ_t`, the one that makes the epigraph
-/// variable's stationarity exact (`∂φ/∂t + μ_t ⟨F_t, S⁻¹⟩ = 0`); the fit is then over the
-/// other coordinates.
-fn centred_duals(
-    sdp: &Sdp,
-    gradient: &[f64],
-    s: &[f64],
-    works: &[BlockWork],
-    value: f64,
-    scale: f64,
-) -> Duals {
-    let k = sdp.vars();
-    let mut own = vec![None; works.len()];
-    if let Some((t, j)) = sdp.epigraph {
-        let d = sdp.blocks[j].coefficients[t].as_ref().map_or(0.0, |f| inner(f, &works[j].s_inv));
-        let mu_t = -gradient[t] / d;
-        if mu_t.is_finite() && mu_t > 0.0 {
-            own[j] = Some(mu_t);
-        }
-    }
-    let mut b = vec![0.0; k];
-    let mut g = gradient.to_vec();
-    for (r, sr) in s.iter().enumerate() {
-        for a in 0..k {
-            b[a] -= sdp.rows[r * k + a] / sr;
-        }
-    }
-    for (j, (blk, w)) in sdp.blocks.iter().zip(works).enumerate() {
-        for a in 0..k {
-            if let Some(fa) = &blk.coefficients[a] {
-                match own[j] {
-                    Some(mu_t) => g[a] += mu_t * inner(fa, &w.s_inv),
-                    None => b[a] += inner(fa, &w.s_inv),
-                }
-            }
-        }
-    }
-    if let Some((t, _)) = sdp.epigraph {
-        b[t] = 0.0;
-        g[t] = 0.0;
-    }
-    let bb: f64 = b.iter().map(|v| v * v).sum();
-    let gb: f64 = b.iter().zip(&g).map(|(x, y)| x * y).sum();
-    let nu = (s.len() + works.iter().map(|w| w.s.len().isqrt()).sum::<usize>()) as f64;
-    let floor = 1e-3 * value.abs().max(scale) / nu.max(1.0);
-    let mu = if bb > 0.0 { (-gb / bb).max(floor) } else { floor };
-    Duals {
-        y: s.iter().map(|v| mu / v).collect(),
-        z: works
-            .iter()
-            .zip(&own)
-            .map(|(w, o)| w.s_inv.iter().map(|v| o.unwrap_or(mu) * v).collect())
-            .collect(),
     }
 }

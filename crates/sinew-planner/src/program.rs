@@ -1,0 +1,268 @@
+//! The interior-point method's problem: linear rows and linear matrix inequalities on `x`, a
+//! concave objective, the multipliers, how a run stops and ends; and the certificate, which
+//! bounds the optimum from any strictly feasible point and any multipliers.
+//!
+//! # Math
+//! Maximise `φ(x) = c₀ + cᵀx + ψ(x)` (`ψ` smooth and concave, or absent) subject to
+//! `s = h − G x ≥ 0` (multipliers `y`) and `S_j = F_j(x) = F_j0 + Σ_a x_a F_ja ⪰ 0`
+//! (multipliers `Z_j`).
+//!
+//! **Certificate.** For any `y ≥ 0`, `Z ⪰ 0`, the Lagrangian
+//! `L(x) = φ(x) + yᵀ(h − Gx) + Σ⟨Z_j, F_j(x)⟩` is concave and `≥ φ` on the feasible set, so with
+//! `r = ∇L(x̄) = ∇φ(x̄) − Gᵀy + F*(Z)` and a box `[lo, hi]` that holds an optimum,
+//!
+//! ```text
+//! UB = φ(x̄) + yᵀs + Σ⟨Z_j, S_j⟩ + Σ_a max(r_a (hi_a − x̄_a), r_a (lo_a − x̄_a))  ≥  max φ.
+//! ```
+//!
+//! An epigraph variable `t` (unbounded, in one block only, not in a row) has its block's `Z`
+//! scaled so that `r_t = 0` exactly. Nothing in the bound depends on how `y` and `Z` were found.
+
+#[cfg(test)]
+use crate::dense::cholesky;
+use crate::dense::inner;
+
+/// One matrix inequality `F(x) = F_0 + Σ_a x_a F_a ⪰ 0` (each n × n, row-major, symmetric).
+#[derive(Debug, Clone)]
+pub(crate) struct Block {
+    pub(crate) n: usize,
+    pub(crate) constant: Vec<f64>,
+    /// One per variable; `None` where the block does not depend on it.
+    pub(crate) coefficients: Vec<Option<Vec<f64>>>,
+}
+
+impl Block {
+    /// `F(x)` into `out`.
+    pub(crate) fn at(&self, x: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(&self.constant);
+        for (xa, fa) in x.iter().zip(&self.coefficients) {
+            if let Some(fa) = fa {
+                for (o, f) in out.iter_mut().zip(fa) {
+                    *o += xa * f;
+                }
+            }
+        }
+    }
+}
+
+/// The problem: maximise `c₀ + cᵀx + ψ(x)` over rows and blocks; `[lo, hi]` bounds an optimum.
+#[derive(Debug, Clone)]
+pub(crate) struct Sdp {
+    pub(crate) c0: f64,
+    pub(crate) c: Vec<f64>,
+    /// `G`, rows × vars, row-major.
+    pub(crate) rows: Vec<f64>,
+    pub(crate) rhs: Vec<f64>,
+    pub(crate) blocks: Vec<Block>,
+    pub(crate) lo: Vec<f64>,
+    pub(crate) hi: Vec<f64>,
+    /// `(variable, block)` of an epigraph variable.
+    pub(crate) epigraph: Option<(usize, usize)>,
+}
+
+impl Sdp {
+    pub(crate) fn vars(&self) -> usize {
+        self.c.len()
+    }
+
+    pub(crate) fn row_count(&self) -> usize {
+        self.rhs.len()
+    }
+
+    /// `h − G x` into `s`.
+    pub(crate) fn slacks(&self, x: &[f64], s: &mut [f64]) {
+        let k = self.vars();
+        for (r, si) in s.iter_mut().enumerate() {
+            let g = &self.rows[r * k..r * k + k];
+            *si = self.rhs[r] - g.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+}
+
+/// A smooth concave part `ψ` of the objective.
+pub(crate) trait Smooth {
+    /// `ψ(x)`, its gradient and its Hessian (vars × vars, ⪯ 0); `None` outside its domain.
+    fn evaluate(&mut self, x: &[f64], gradient: &mut [f64], hessian: &mut [f64]) -> Option<f64>;
+}
+
+/// How a run stops.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Settings {
+    /// Stop at `UB − φ ≤ relative_gap · max(|φ|, scale)`.
+    pub(crate) relative_gap: f64,
+    pub(crate) scale: f64,
+    pub(crate) max_iterations: usize,
+    /// Stop as soon as `φ ≥ target` (a feasibility phase) and `φ − target` is at least
+    /// `centring` of `UB − target` (so that the point is well inside, not on the target's
+    /// boundary), or at the optimum when it is above the target; or when `UB < target`.
+    pub(crate) target: Option<f64>,
+    pub(crate) centring: f64,
+}
+
+/// The multipliers `y` (rows) and `Z_j` (blocks).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Duals {
+    pub(crate) y: Vec<f64>,
+    pub(crate) z: Vec<Vec<f64>>,
+}
+
+/// How a run ended: the last iterate, its value, its certified bound, the iterations.
+#[derive(Debug, Clone)]
+pub(crate) struct Run {
+    pub(crate) x: Vec<f64>,
+    pub(crate) value: f64,
+    pub(crate) upper: f64,
+    pub(crate) iterations: usize,
+    pub(crate) end: End,
+}
+
+/// Why a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum End {
+    /// The gap closed.
+    Optimum,
+    /// `φ ≥ target`.
+    Reached,
+    /// `UB < target`.
+    Unreachable,
+    /// The iterations ran out.
+    NotConverged,
+    /// The iterate left the interior or the objective's domain (numerical breakdown).
+    Breakdown,
+}
+
+/// The certified upper bound at `x` with `(y, Z)` (module docs), given the slacks `s` and the
+/// blocks' values `S_j` (row-major).
+pub(crate) fn upper_bound(
+    sdp: &Sdp,
+    x: &[f64],
+    value: f64,
+    gradient: &[f64],
+    s: &[f64],
+    slack_matrices: &[&[f64]],
+    duals: &Duals,
+) -> f64 {
+    let k = sdp.vars();
+    let mut scales = vec![1.0; sdp.blocks.len()];
+    let dual_term = |a: usize, j: usize, z: &[f64]| -> f64 {
+        sdp.blocks[j].coefficients[a].as_ref().map_or(0.0, |f| inner(f, z))
+    };
+    if let Some((t, j)) = sdp.epigraph {
+        let d = dual_term(t, j, &duals.z[j]);
+        let kappa = -gradient[t] / d;
+        if !(kappa.is_finite() && kappa > 0.0) {
+            return f64::INFINITY;
+        }
+        scales[j] = kappa;
+    }
+    let mut bound = value + duals.y.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
+    for (j, m) in slack_matrices.iter().enumerate() {
+        bound += scales[j] * inner(&duals.z[j], m);
+    }
+    for a in 0..k {
+        if sdp.epigraph.is_some_and(|(t, _)| t == a) {
+            continue;
+        }
+        let mut r = gradient[a];
+        for (row, y) in duals.y.iter().enumerate() {
+            r -= sdp.rows[row * k + a] * y;
+        }
+        for j in 0..sdp.blocks.len() {
+            r += scales[j] * dual_term(a, j, &duals.z[j]);
+        }
+        if r == 0.0 {
+            continue;
+        }
+        let term = (r * (sdp.hi[a] - x[a])).max(r * (sdp.lo[a] - x[a]));
+        if !term.is_finite() {
+            return f64::INFINITY;
+        }
+        bound += term;
+    }
+    bound
+}
+
+/// The certified bound at a strictly feasible `x` with any `y ≥ 0`, `Z ⪰ 0` (module docs),
+/// given `φ(x)` and `∇φ(x)`; `None` when `x` is not strictly feasible.
+#[cfg(test)]
+pub(crate) fn bound_at(
+    sdp: &Sdp,
+    x: &[f64],
+    value: f64,
+    gradient: &[f64],
+    duals: &Duals,
+) -> Option<f64> {
+    let mut s = vec![0.0; sdp.row_count()];
+    sdp.slacks(x, &mut s);
+    let matrices: Vec<Vec<f64>> = sdp
+        .blocks
+        .iter()
+        .map(|b| {
+            let mut m = vec![0.0; b.n * b.n];
+            b.at(x, &mut m);
+            m
+        })
+        .collect();
+    let inside = s.iter().all(|v| *v >= 0.0)
+        && sdp.blocks.iter().zip(&matrices).all(|(b, m)| cholesky(&mut m.clone(), b.n));
+    let refs: Vec<&[f64]> = matrices.iter().map(Vec::as_slice).collect();
+    inside.then(|| upper_bound(sdp, x, value, gradient, &s, &refs, duals))
+}
+
+/// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the
+/// least-squares fit of stationarity `∇φ + μ (−Gᵀ(1/s) + F*(S⁻¹)) = 0` (floored at a small
+/// positive value). An epigraph block gets its own `μ_t`, the one that makes the epigraph
+/// variable's stationarity exact (`∂φ/∂t + μ_t ⟨F_t, S⁻¹⟩ = 0`); the fit is then over the
+/// other coordinates.
+pub(crate) fn centred_duals(
+    sdp: &Sdp,
+    gradient: &[f64],
+    s: &[f64],
+    s_inverses: &[&[f64]],
+    value: f64,
+    scale: f64,
+) -> Duals {
+    let k = sdp.vars();
+    let mut own = vec![None; s_inverses.len()];
+    if let Some((t, j)) = sdp.epigraph {
+        let d = sdp.blocks[j].coefficients[t].as_ref().map_or(0.0, |f| inner(f, s_inverses[j]));
+        let mu_t = -gradient[t] / d;
+        if mu_t.is_finite() && mu_t > 0.0 {
+            own[j] = Some(mu_t);
+        }
+    }
+    let mut b = vec![0.0; k];
+    let mut g = gradient.to_vec();
+    for (r, sr) in s.iter().enumerate() {
+        for a in 0..k {
+            b[a] -= sdp.rows[r * k + a] / sr;
+        }
+    }
+    for (j, (blk, w)) in sdp.blocks.iter().zip(s_inverses).enumerate() {
+        for a in 0..k {
+            if let Some(fa) = &blk.coefficients[a] {
+                match own[j] {
+                    Some(mu_t) => g[a] += mu_t * inner(fa, w),
+                    None => b[a] += inner(fa, w),
+                }
+            }
+        }
+    }
+    if let Some((t, _)) = sdp.epigraph {
+        b[t] = 0.0;
+        g[t] = 0.0;
+    }
+    let bb: f64 = b.iter().map(|v| v * v).sum();
+    let gb: f64 = b.iter().zip(&g).map(|(x, y)| x * y).sum();
+    let nu = (s.len() + sdp.blocks.iter().map(|b| b.n).sum::<usize>()) as f64;
+    let floor = 1e-3 * value.abs().max(scale) / nu.max(1.0);
+    let mu = if bb > 0.0 { (-gb / bb).max(floor) } else { floor };
+    Duals {
+        y: s.iter().map(|v| mu / v).collect(),
+        z: s_inverses
+            .iter()
+            .zip(&own)
+            .map(|(w, o)| w.iter().map(|v| o.unwrap_or(mu) * v).collect())
+            .collect(),
+    }
+}
