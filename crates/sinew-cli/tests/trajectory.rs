@@ -21,7 +21,7 @@ fn csv(values: &[f64]) -> String {
     values.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(",")
 }
 
-/// 20 steps at 1 kHz around E4, the wrench on each row.
+/// 20 steps at 1 kHz near E4, the wrench on each row.
 fn trajectory_file(name: &str) -> (PathBuf, Vec<Vec<f64>>) {
     let dir = std::env::temp_dir().join(format!("sinew-trajectory-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -30,8 +30,12 @@ fn trajectory_file(name: &str) -> (PathBuf, Vec<Vec<f64>>) {
         String::from("# q1..q10, FX..MZ\nq1,q2,q3,q4,q5,q6,q7,q8,q9,q10,fx,fy,fz,mx,my,mz\n");
     let mut poses = Vec::new();
     for k in 0..20 {
+        // Towards zero from E4 (whose joint 3 sits at its limit), up to 5 %.
         let q: Vec<f64> = (0..10)
-            .map(|j| E4_Q[j] + 0.2 * ((0.5 + 14.5 * j as f64 / 9.0) * k as f64 * 1e-3).sin())
+            .map(|j| {
+                let omega = 0.5 + 14.5 * j as f64 / 9.0;
+                E4_Q[j] * (1.0 - 0.05 * (omega * k as f64 * 1e-3).sin().abs())
+            })
             .collect();
         text.push_str(&format!("{},{}\n", csv(&q), csv(&E4_F0)));
         poses.push(q);

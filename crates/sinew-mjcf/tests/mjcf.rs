@@ -290,6 +290,12 @@ fn bad_input_is_a_typed_error_naming_what_is_wrong() {
     q[4] = 0.6;
     let e = run(&q, &ok, WRENCH, &o).unwrap_err();
     assert!(matches!(e, MjcfError::Robot(_)) && e.to_string().contains("joint3_x"), "{e}");
+    // A routing of another robot (a 2-joint chain's cables on cdhrm5): the routing's error.
+    let (_, other) = sinew_testkit::cdhrm5::chain(2, PatternModel::Decoupled);
+    let e =
+        to_mjcf(&robot, &other, &State { q: &LOADED_POSE, tensions: &ok[..6], wrench: WRENCH }, &o)
+            .unwrap_err();
+    assert!(matches!(e, MjcfError::Routing(_)), "{e:?}");
     let e = run(&LOADED_POSE, &ok[..14], WRENCH, &o).unwrap_err();
     assert!(matches!(e, MjcfError::TensionCount { expected: 15, got: 14 }), "{e}");
     let mut f = ok;

@@ -120,16 +120,17 @@ impl<'a> Interior<'a> {
         sdp.hi[k] = 1.0;
         let mut start = x0;
         start.push(tau0);
-        let run = sdp::solve(&sdp, None, &start, self.settings(None, 0.3, 1e-3));
-        if run.value > 0.0 {
-            let mut x = run.x;
-            x.pop();
-            return Ok((x, run.iterations));
+        // Until τ > 0 well inside (or the bound proves τ* ≤ 0: no point strictly inside).
+        let run = sdp::solve(&sdp, None, &start, self.settings(Some(0.0), 1e-9, 1e-9));
+        match run.end {
+            End::Reached => {
+                let mut x = run.x;
+                x.pop();
+                Ok((x, run.iterations))
+            }
+            End::Unreachable | End::Optimum => Err(PlanError::BudgetsInfeasible),
+            _ => Err(not_converged(&run, 1e-9)),
         }
-        if run.upper <= 0.0 || run.end == End::Optimum {
-            return Err(PlanError::BudgetsInfeasible);
-        }
-        Err(PlanError::NotConverged { iterations: run.iterations, gap: run.upper, tolerance: 0.0 })
     }
 
     /// Phase 1: from `x` inside the rows, a point with margin ≥ the requirement.
