@@ -7,7 +7,7 @@ use sinew::indicators::IndicatorError;
 use sinew::planner::PlanError;
 use sinew::robot::RobotError;
 use sinew::routing::{JointProblem, RoutingError};
-use sinew::statics::{InfeasibleReason, StaticsError, UnsupportedRouting};
+use sinew::statics::{InfeasibleReason, SolverStop, StaticsError, UnsupportedRouting};
 use sinew::stiffness::StiffnessError;
 use sinew::{Error, ErrorKind, InputAtFault};
 
@@ -156,7 +156,7 @@ fn statics_errors() -> Vec<(StaticsError, ErrorKind)> {
         ),
         (StaticsError::NonFiniteInput { what: "T0" }, ErrorKind::Numerical),
         (StaticsError::Numerical { what: "the SVD of J_c" }, ErrorKind::Numerical),
-        (StaticsError::Solver { status: "MaxIterations".into() }, ErrorKind::Numerical),
+        (StaticsError::Solver { stop: SolverStop::MaxIterations }, ErrorKind::Numerical),
         (StaticsError::Robot(out_of_limits()), ErrorKind::Input),
         (StaticsError::Routing(degenerate()), ErrorKind::Numerical),
     ]
@@ -228,7 +228,8 @@ fn planner_errors() -> Vec<(PlanError, ErrorKind)> {
             PlanError::NotConverged { iterations: 100, gap: 1e-2, tolerance: 1e-6 },
             ErrorKind::Numerical,
         ),
-        (PlanError::Solver { status: "MaxIterations".into() }, ErrorKind::Numerical),
+        (PlanError::Solver { stop: SolverStop::MaxIterations }, ErrorKind::Numerical),
+        (PlanError::Numerical { what: "eigendecomposition of K_q + K_W" }, ErrorKind::Numerical),
         (PlanError::Statics(Box::new(infeasible())), ErrorKind::Infeasible),
         (
             PlanError::Stiffness(Box::new(StiffnessError::Unstable { min_eigenvalue: -1.0 })),

@@ -20,6 +20,7 @@
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use sinew_statics::SolverStop;
 use sinew_statics::convex::dense_csc;
 
 use crate::error::PlanError;
@@ -173,8 +174,7 @@ pub(crate) fn maximise(
                 let gap = upper - value;
                 if gap < -1e-9 * value.abs().max(settings.scale) {
                     // A bound below a feasible value: the LP's answer is not to be trusted.
-                    let status = format!("LP bound {upper:e} below a feasible value {value:e}");
-                    return Err(PlanError::Solver { status });
+                    return Err(PlanError::Solver { stop: SolverStop::InconsistentBound });
                 }
                 if gap <= settings.relative_gap * value.abs().max(settings.scale) {
                     return Ok(Outcome::Optimum {
@@ -341,18 +341,18 @@ fn solve(
         ..DefaultSettings::default()
     };
     let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-        .map_err(|e| PlanError::Solver { status: format!("setup: {e}") })?;
+        .map_err(|_| PlanError::Solver { stop: SolverStop::Setup })?;
     solver.solve();
     match solver.solution.status {
         // An LP answer only to reduced accuracy is no bound (its value can be 10⁻³ low).
         SolverStatus::AlmostSolved if !quadratic => {
-            Err(PlanError::Solver { status: "AlmostSolved".into() })
+            Err(PlanError::Solver { stop: SolverStop::ReducedAccuracy })
         }
         SolverStatus::Solved | SolverStatus::AlmostSolved => {
             Ok(Some(solver.solution.x.iter().zip(&column_scale).map(|(x, d)| x * d).collect()))
         }
         SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Ok(None),
-        status => Err(PlanError::Solver { status: format!("{status:?}") }),
+        status => Err(PlanError::Solver { stop: SolverStop::from_status(status) }),
     }
 }
 

@@ -91,10 +91,16 @@ pub enum PlanError {
         tolerance: f64,
     },
     /// The convex solver (clarabel) stopped without an answer or a certificate.
-    #[error("the convex solver stopped without an answer: {status}")]
+    #[error("the convex solver stopped without an answer: {stop}")]
     Solver {
-        /// Its status.
-        status: String,
+        /// Why it stopped.
+        stop: sinew_statics::SolverStop,
+    },
+    /// A dense factorisation of the planner's own failed to converge.
+    #[error("the {what} did not converge")]
+    Numerical {
+        /// Which (e.g. the eigendecomposition of `K_q + K_W`).
+        what: &'static str,
     },
     /// The statics (infeasible loads among them). Boxed, as it is large.
     #[error(transparent)]
@@ -125,7 +131,9 @@ impl PlanError {
             PlanError::NonConservativeLoad { .. } | PlanError::InvalidInput { .. } => {
                 ErrorKind::Input
             }
-            PlanError::NotConverged { .. } | PlanError::Solver { .. } => ErrorKind::Numerical,
+            PlanError::NotConverged { .. }
+            | PlanError::Solver { .. }
+            | PlanError::Numerical { .. } => ErrorKind::Numerical,
             PlanError::Statics(e) => e.kind(),
             PlanError::Stiffness(e) => e.kind(),
             PlanError::Routing(e) => e.kind(),

@@ -78,7 +78,7 @@ impl Pencil {
         let a = self.at(lambda);
         let eigen = a
             .self_adjoint_eigen(Side::Lower)
-            .map_err(|_| PlanError::Solver { status: "eigendecomposition of K_q + K_W".into() })?;
+            .map_err(|_| PlanError::Numerical { what: "eigendecomposition of K_q + K_W" })?;
         let value = eigen.S().column_vector()[0];
         let v = eigen.U().subcols(0, 1);
         Ok((value, self.forms(v)))

@@ -15,7 +15,7 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use faer::MatRef;
 
-use crate::error::StaticsError;
+use crate::error::{SolverStop, StaticsError};
 use crate::interval::FORCE_CLOSURE_TOLERANCE;
 
 /// A dense `rows × cols` matrix, given entry by entry by `at(row, column)`, as clarabel's
@@ -52,8 +52,8 @@ pub(crate) enum Solved {
     /// The optimum `x` (solved or almost solved) and the interior-point iterations.
     Point { x: Vec<f64>, iterations: u32 },
     /// The program is (almost) primal infeasible: the certificate `z` (one entry per row of
-    /// `A`), and clarabel's status by name for an error message.
-    Infeasible { z: Vec<f64>, status: String },
+    /// `A`).
+    Infeasible { z: Vec<f64> },
 }
 
 /// `min ½ xᵀ P x + qᵀ x` subject to `A x ≤ b`, with `P = I` when `quadratic`, else `P = 0`;
@@ -72,17 +72,17 @@ pub(crate) fn solve(
     let p = if quadratic { CscMatrix::identity(n) } else { CscMatrix::zeros((n, n)) };
     let cones = [SupportedConeT::NonnegativeConeT(b.len())];
     let mut solver = DefaultSolver::new(&p, q, a, b, &cones, settings())
-        .map_err(|e| StaticsError::Solver { status: format!("setup: {e}") })?;
+        .map_err(|_| StaticsError::Solver { stop: SolverStop::Setup })?;
     solver.solve();
     let solution = solver.solution;
     match solution.status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => {
             Ok(Solved::Point { x: solution.x, iterations: solution.iterations })
         }
-        status @ (SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible) => {
-            Ok(Solved::Infeasible { z: solution.z, status: format!("{status:?}") })
+        SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+            Ok(Solved::Infeasible { z: solution.z })
         }
-        status => Err(StaticsError::Solver { status: format!("{status:?}") }),
+        status => Err(StaticsError::Solver { stop: SolverStop::from_status(status) }),
     }
 }
 
@@ -116,7 +116,10 @@ pub(crate) fn force_closure(null: MatRef<'_, f64>) -> Result<bool, StaticsError>
     q[k] = -1.0;
     match solve(false, &q, &a, &b)? {
         Solved::Point { x, .. } => Ok(x[k] > FORCE_CLOSURE_TOLERANCE),
-        Solved::Infeasible { status, .. } => Err(StaticsError::Solver { status }),
+        // λ = 0, t = −1 is feasible: an infeasibility report is the solver's failure.
+        Solved::Infeasible { .. } => {
+            Err(StaticsError::Solver { stop: SolverStop::FalseInfeasibility })
+        }
     }
 }
 
@@ -154,5 +157,46 @@ mod tests {
         }
         assert_eq!(dense_csc(3, 2, |_, _| 0.0), CscMatrix::zeros((3, 2)));
         assert_eq!(dense_csc(4, 4, |r, c| f64::from(u8::from(r == c))), CscMatrix::identity(4));
+    }
+
+    #[test]
+    fn every_clarabel_stop_has_its_own_variant_and_message() {
+        use SolverStatus as S;
+        let cases = [
+            (S::MaxIterations, SolverStop::MaxIterations),
+            (S::MaxTime, SolverStop::MaxTime),
+            (S::NumericalError, SolverStop::NumericalError),
+            (S::InsufficientProgress, SolverStop::InsufficientProgress),
+            (S::DualInfeasible, SolverStop::Unbounded),
+            (S::AlmostDualInfeasible, SolverStop::Unbounded),
+            (S::Unsolved, SolverStop::NotRun),
+            (S::CallbackTerminated, SolverStop::NotRun),
+            (S::AlmostSolved, SolverStop::ReducedAccuracy),
+            (S::PrimalInfeasible, SolverStop::FalseInfeasibility),
+        ];
+        for (status, stop) in cases {
+            assert_eq!(SolverStop::from_status(status), stop, "{status:?}");
+        }
+        let messages: std::collections::BTreeSet<String> = [
+            SolverStop::Setup,
+            SolverStop::ReducedAccuracy,
+            SolverStop::FalseInfeasibility,
+            SolverStop::Unbounded,
+            SolverStop::InconsistentBound,
+            SolverStop::MaxIterations,
+            SolverStop::MaxTime,
+            SolverStop::NumericalError,
+            SolverStop::InsufficientProgress,
+            SolverStop::NotRun,
+        ]
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+        assert_eq!(messages.len(), 10, "one message per stop");
+        let e = StaticsError::Solver { stop: SolverStop::MaxIterations };
+        assert_eq!(
+            e.to_string(),
+            "the tension solver stopped without an answer: iteration limit reached"
+        );
     }
 }

@@ -4,6 +4,71 @@ use sinew_robot::{Compact, ErrorKind};
 
 use crate::refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
 
+/// Why a convex solve (clarabel's, in the tension policies, the force-closure LP and the
+/// planner's bundle subproblems) ended without an answer that can be used: one variant per
+/// way, so that callers match on it rather than on a message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SolverStop {
+    /// The solver refused the program at setup (sizes, a non-finite entry).
+    Setup,
+    /// It reached only reduced accuracy where a bound must be exact (an LP bound).
+    ReducedAccuracy,
+    /// It reported a program infeasible that has a feasible point by construction.
+    FalseInfeasibility,
+    /// It reported the program unbounded (dual infeasible).
+    Unbounded,
+    /// Its bound lies below a value already found feasible: the answer is not to be trusted.
+    InconsistentBound,
+    /// It ran out of iterations.
+    MaxIterations,
+    /// It ran out of time.
+    MaxTime,
+    /// It met a numerical error (a failed factorisation).
+    NumericalError,
+    /// It stopped making progress.
+    InsufficientProgress,
+    /// It did not run (unsolved, or stopped by a callback).
+    NotRun,
+}
+
+impl SolverStop {
+    /// The stop for a clarabel status that is neither solved nor primal infeasible (those are
+    /// answers, not stops; given one, the closest stop: reduced accuracy or a false
+    /// infeasibility).
+    #[must_use]
+    pub fn from_status(status: clarabel::solver::SolverStatus) -> Self {
+        use clarabel::solver::SolverStatus as S;
+        match status {
+            S::Solved | S::AlmostSolved => SolverStop::ReducedAccuracy,
+            S::PrimalInfeasible | S::AlmostPrimalInfeasible => SolverStop::FalseInfeasibility,
+            S::DualInfeasible | S::AlmostDualInfeasible => SolverStop::Unbounded,
+            S::MaxIterations => SolverStop::MaxIterations,
+            S::MaxTime => SolverStop::MaxTime,
+            S::NumericalError => SolverStop::NumericalError,
+            S::InsufficientProgress => SolverStop::InsufficientProgress,
+            S::Unsolved | S::CallbackTerminated => SolverStop::NotRun,
+        }
+    }
+}
+
+impl std::fmt::Display for SolverStop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SolverStop::Setup => "the program was refused at setup",
+            SolverStop::ReducedAccuracy => "solved only to reduced accuracy",
+            SolverStop::FalseInfeasibility => "reported infeasible a program that has a point",
+            SolverStop::Unbounded => "reported the program unbounded",
+            SolverStop::InconsistentBound => "a bound below a feasible value",
+            SolverStop::MaxIterations => "iteration limit reached",
+            SolverStop::MaxTime => "time limit reached",
+            SolverStop::NumericalError => "numerical error",
+            SolverStop::InsufficientProgress => "insufficient progress",
+            SolverStop::NotRun => "did not run",
+        })
+    }
+}
+
 /// Why a routing does not fit the closed-form statics: three cables per universal joint, in
 /// joint order, none changing length with a joint beyond its own.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -186,10 +251,10 @@ pub enum StaticsError {
         what: &'static str,
     },
     /// The convex solver (clarabel) stopped without an answer or a certificate.
-    #[error("the tension solver stopped without an answer: {status}")]
+    #[error("the tension solver stopped without an answer: {stop}")]
     Solver {
-        /// The solver's status.
-        status: String,
+        /// Why it stopped.
+        stop: SolverStop,
     },
     /// An error of the robot model (sizes, workspace).
     #[error(transparent)]

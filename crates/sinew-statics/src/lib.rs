@@ -68,7 +68,7 @@ pub use arm::{ArmStatics, ArmStaticsData};
 pub use choice::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, SET_RANK_TOLERANCE};
-pub use error::{NoEquilibrium, NoEquilibriumCause, StaticsError, UnsupportedRouting};
+pub use error::{NoEquilibrium, NoEquilibriumCause, SolverStop, StaticsError, UnsupportedRouting};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, JOINT_RANK_TOLERANCE, TensionInterval, TensionLimits,
     minimum_norm_tensions, tension_interval,
