@@ -1,6 +1,21 @@
 //! `ColMajor`: the dense dof × dof and 6 × dof matrices of the pipeline, in plain `Vec`s.
 
+use std::ops::Range;
+
 use faer::{MatMut, MatRef};
+
+/// The symmetric mirror, the one loop of every copy of an upper triangle onto the lower one:
+/// calls `copy(i, j)` for each strictly lower position `i > j` of the diagonal block `block`,
+/// column by column (`j` ascending, then `i`), and the caller's `copy` sets entry `(i, j)`
+/// from `(j, i)` in its own storage (a [`ColMajor`], a faer view or a fixed array).
+#[inline(always)]
+pub(crate) fn mirror_upper(block: Range<usize>, mut copy: impl FnMut(usize, usize)) {
+    for j in block.clone() {
+        for i in j + 1..block.end {
+            copy(i, j);
+        }
+    }
+}
 
 /// A dense column-major matrix in a plain `Vec` (no padding), viewed as a faer matrix at the
 /// API boundary; the structured kernels read it by slices.

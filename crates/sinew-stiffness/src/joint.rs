@@ -23,7 +23,7 @@ use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
 use sinew_routing::{HessianBatch, Routing, RoutingData, SegmentHessians};
 
-use crate::colmajor::ColMajor;
+use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
 use crate::inherent::{InherentPlan, InherentScratch};
 use crate::structured::{BlockLayout, MAX_BLOCK, zero_blocks};
@@ -65,7 +65,7 @@ pub fn joint_stiffness(
     geometry.add_weighted_hessians(routing, tensions, controllable.as_mut())?;
     inherent.fill(0.0);
     add_inherent_upper(routing, geometry, inherent.as_mut())?;
-    mirror_upper(inherent, std::iter::once(0..n));
+    mirror_blocks(inherent, std::iter::once(0..n));
     Ok(())
 }
 
@@ -351,7 +351,7 @@ fn add_weighted_hessians_batched<'a>(
 }
 
 /// Within each diagonal block `blocks`: the strict upper triangle of `inherent` copied to its
-/// lower one ([`mirror_upper`] on the arm's own storage), and `K_q = K_c + K_i`, in one pass
+/// lower one ([`mirror_upper`] on the arm's own storage, fused), and `K_q = K_c + K_i`, in one pass
 /// column by column (the lower part of column `j` of `K_i` from row `j` of the later columns,
 /// then the column of `K_q` while it is in cache). The same values as mirroring, then summing.
 fn mirror_and_sum(
@@ -378,13 +378,9 @@ fn mirror_and_sum(
     }
 }
 
-fn mirror_upper(mut out: MatMut<'_, f64>, blocks: impl Iterator<Item = Range<usize>>) {
+fn mirror_blocks(mut out: MatMut<'_, f64>, blocks: impl Iterator<Item = Range<usize>>) {
     for block in blocks {
-        for j in block.clone() {
-            for i in j + 1..block.end {
-                out[(i, j)] = out[(j, i)];
-            }
-        }
+        mirror_upper(block, |i, j| out[(i, j)] = out[(j, i)]);
     }
 }
 

@@ -110,7 +110,7 @@ use sinew_statics::KwGenerators;
 pub(crate) use kernels::{lu, lu_solve};
 pub(crate) use layout::{BlockLayout, MAX_BLOCK, zero_blocks};
 
-use crate::colmajor::ColMajor;
+use crate::colmajor::{ColMajor, mirror_upper};
 use check::check;
 use sweep::{BlockFactor, Sweep, step_general, step_symmetric, step_symmetric_part};
 
@@ -199,11 +199,8 @@ pub(crate) fn compliance(
         }
     }
     if gens.is_symmetric() {
-        for p in 0..6 {
-            for q in 0..p {
-                sweep.c_x[p][q] = sweep.c_x[q][p];
-            }
-        }
+        let c_x = &mut sweep.c_x;
+        mirror_upper(0..6, |i, j| c_x[i][j] = c_x[j][i]);
     }
     data.c_x = sweep.c_x;
     let accepted = check(layout, gens, data);

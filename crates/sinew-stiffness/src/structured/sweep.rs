@@ -8,7 +8,7 @@ use super::kernels::{
     add_at_b, add_at_b_upper, add_gram, dot, forward, ldlt, lu, lu_solve, mul3, mul3t, scale, sub3,
 };
 use super::{CHECK_WEIGHTS, MAX_BLOCK};
-use crate::colmajor::ColMajor;
+use crate::colmajor::{ColMajor, mirror_upper};
 
 /// The state carried from the tip to the base (module docs): `P`, `Z`, `Z'`, `C_x`.
 pub(crate) struct Sweep {
@@ -173,11 +173,8 @@ pub(crate) fn step_symmetric<const B: usize>(
     add_at_b_upper(&mut st.c_x, &dg, &g);
     add_at_b(&mut st.z, &de, &g);
     add_at_b_upper(&mut st.p, &de, &e);
-    for p in 0..3 {
-        for q in p + 1..3 {
-            st.p[q][p] = st.p[p][q];
-        }
-    }
+    let p = &mut st.p;
+    mirror_upper(0..3, |i, j| p[i][j] = p[j][i]);
     factor.save(&l, &[0; B], &u_t, &rhs);
     true
 }
