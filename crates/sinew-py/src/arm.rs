@@ -8,13 +8,13 @@ use std::sync::{Mutex, OnceLock};
 use std::collections::BTreeMap;
 
 use nalgebra::Vector6;
-use numpy::PyArray1;
+use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use sinew::planner::{Planner, PlannerData};
 use sinew::statics::{Chosen, TensionChoice, TensionPolicy};
 use sinew::stiffness::ArmStiffnessData;
 
-use crate::batch::{BatchChoice, evaluate_many};
+use crate::batch::{Batch, BatchChoice, evaluate_many};
 use crate::convert::{matrix, na2, reshape, vec1, vector, wrenches};
 use crate::errors::{exception, input, library};
 use crate::lazy::LazyArray;
@@ -256,21 +256,20 @@ impl ArmStiffness {
         {
             return Err(exception(*kind, format!("every row failed; row 0: {message}")));
         }
-        let cables = batch.cables;
-        let bools = |v: &[bool]| -> PyResult<Py<PyAny>> {
-            Ok(PyArray1::from_slice(py, v).into_any().unbind())
-        };
+        // The buffers move into numpy (no copy of the 10⁶-row results).
+        let Batch {
+            cables, ok, stable, min_eigenvalue, t0, tensions, c_x, k_x, k_fd, errors, ..
+        } = batch;
         Ok(BatchResult {
-            ok: bools(&batch.ok)?,
-            stable: bools(&batch.stable)?,
-            min_eigenvalue: vec1(py, &batch.min_eigenvalue).into_any().unbind(),
-            t0: reshape(vec1(py, &batch.t0), &[rows, dof])?.unbind(),
-            tensions: reshape(vec1(py, &batch.tensions), &[rows, cables])?.unbind(),
-            c_x: reshape(vec1(py, &batch.c_x), &[rows, 6, 6])?.unbind(),
-            k_x: reshape(vec1(py, &batch.k_x), &[rows, 6, 6])?.unbind(),
-            k_fd: reshape(vec1(py, &batch.k_fd), &[rows, 3, 3])?.unbind(),
-            errors: batch
-                .errors
+            ok: ok.into_pyarray(py).into_any().unbind(),
+            stable: stable.into_pyarray(py).into_any().unbind(),
+            min_eigenvalue: min_eigenvalue.into_pyarray(py).into_any().unbind(),
+            t0: reshape(t0.into_pyarray(py), &[rows, dof])?.unbind(),
+            tensions: reshape(tensions.into_pyarray(py), &[rows, cables])?.unbind(),
+            c_x: reshape(c_x.into_pyarray(py), &[rows, 6, 6])?.unbind(),
+            k_x: reshape(k_x.into_pyarray(py), &[rows, 6, 6])?.unbind(),
+            k_fd: reshape(k_fd.into_pyarray(py), &[rows, 3, 3])?.unbind(),
+            errors: errors
                 .into_iter()
                 .map(|(r, kind, message)| (r, kind.to_string(), message))
                 .collect(),

@@ -53,35 +53,23 @@ pub struct Batch {
 /// Rows per parallel task.
 const CHUNK: usize = 32;
 
-/// Per-row scalars and the 6 × 6 / 3 × 3 results, written in place.
-#[derive(Debug, Clone)]
-struct Fixed {
-    ok: bool,
-    stable: bool,
-    min_eigenvalue: f64,
-    c_x: [f64; 36],
-    k_x: [f64; 36],
-    k_fd: [f64; 9],
-    error: Option<(ErrorKind, String)>,
-}
-
-impl Fixed {
-    fn nan() -> Fixed {
-        Fixed {
-            ok: false,
-            stable: false,
-            min_eigenvalue: f64::NAN,
-            c_x: [f64::NAN; 36],
-            k_x: [f64::NAN; 36],
-            k_fd: [f64::NAN; 9],
-            error: None,
-        }
-    }
+/// One task's rows of every result buffer: the rows are written in place by the task that
+/// evaluates them, so nothing is copied after the parallel loop.
+struct Part<'a> {
+    ok: &'a mut [bool],
+    stable: &'a mut [bool],
+    min_eigenvalue: &'a mut [f64],
+    t0: &'a mut [f64],
+    tensions: &'a mut [f64],
+    c_x: &'a mut [f64],
+    k_x: &'a mut [f64],
+    k_fd: &'a mut [f64],
 }
 
 /// Evaluate every row of `q` (rows × dof, row-major) under the load `f0`: one wrench for
 /// every row (`f0.len() == 1`) or one per row (`f0.len() == rows`). In parallel on the rayon
-/// pool it is called in (the global pool outside any).
+/// pool it is called in (the global pool outside any), each task writing its rows straight
+/// into the result buffers.
 pub fn evaluate_many(
     arm: &ArmStiffness,
     q: &[f64],
@@ -91,55 +79,86 @@ pub fn evaluate_many(
     let dof = arm.dof();
     let cables = arm.routing().cable_count();
     let rows = q.len().checked_div(dof).unwrap_or(0);
-    let mut fixed = vec![Fixed::nan(); rows];
-    let mut t0 = vec![f64::NAN; rows * dof];
-    let mut tensions = vec![f64::NAN; rows * cables];
-    fixed
-        .par_chunks_mut(CHUNK)
-        .zip(t0.par_chunks_mut(CHUNK * dof.max(1)))
-        .zip(tensions.par_chunks_mut(CHUNK * cables.max(1)))
-        .zip(q.par_chunks(CHUNK * dof.max(1)))
-        .enumerate()
-        .for_each_init(
-            || ArmStiffnessData::new(arm),
-            |data, (chunk, (((fixed, t0), tensions), q))| {
-                for (r, out) in fixed.iter_mut().enumerate() {
-                    let qr = &q[r * dof..(r + 1) * dof];
-                    let f0 = wrench_of_row(f0, chunk * CHUNK + r);
-                    row(arm, data, qr, f0, choice, out);
-                    if out.ok {
-                        t0[r * dof..(r + 1) * dof].copy_from_slice(&data.statics.t0);
-                        tensions[r * cables..(r + 1) * cables].copy_from_slice(data.tensions());
-                    }
-                }
-            },
-        );
+    // Zeroed buffers (the allocator's zeroed pages, not written twice): every entry is then
+    // written once by its row, a value or NaN.
     let mut batch = Batch {
         rows,
         dof,
         cables,
-        ok: Vec::with_capacity(rows),
-        stable: Vec::with_capacity(rows),
-        min_eigenvalue: Vec::with_capacity(rows),
-        t0,
-        tensions,
-        c_x: Vec::with_capacity(rows * 36),
-        k_x: Vec::with_capacity(rows * 36),
-        k_fd: Vec::with_capacity(rows * 9),
+        ok: vec![false; rows],
+        stable: vec![false; rows],
+        min_eigenvalue: vec![0.0; rows],
+        t0: vec![0.0; rows * dof],
+        tensions: vec![0.0; rows * cables],
+        c_x: vec![0.0; rows * 36],
+        k_x: vec![0.0; rows * 36],
+        k_fd: vec![0.0; rows * 9],
         errors: Vec::new(),
     };
-    for (r, f) in fixed.into_iter().enumerate() {
-        batch.ok.push(f.ok);
-        batch.stable.push(f.stable);
-        batch.min_eigenvalue.push(f.min_eigenvalue);
-        batch.c_x.extend_from_slice(&f.c_x);
-        batch.k_x.extend_from_slice(&f.k_x);
-        batch.k_fd.extend_from_slice(&f.k_fd);
-        if let Some((kind, message)) = f.error {
-            batch.errors.push((r, kind, message));
-        }
-    }
+    let parts: Vec<Part<'_>> = cut(&mut batch.ok, 1, rows)
+        .zip(cut(&mut batch.stable, 1, rows))
+        .zip(cut(&mut batch.min_eigenvalue, 1, rows))
+        .zip(cut(&mut batch.t0, dof, rows))
+        .zip(cut(&mut batch.tensions, cables, rows))
+        .zip(cut(&mut batch.c_x, 36, rows))
+        .zip(cut(&mut batch.k_x, 36, rows))
+        .zip(cut(&mut batch.k_fd, 9, rows))
+        .map(|(((((((ok, stable), min_eigenvalue), t0), tensions), c_x), k_x), k_fd)| Part {
+            ok,
+            stable,
+            min_eigenvalue,
+            t0,
+            tensions,
+            c_x,
+            k_x,
+            k_fd,
+        })
+        .collect();
+    let errors: Vec<Vec<(usize, ErrorKind, String)>> = parts
+        .into_par_iter()
+        .enumerate()
+        .map_init(
+            || ArmStiffnessData::new(arm),
+            |data, (chunk, mut part)| {
+                let mut errors = Vec::new();
+                for r in 0..part.ok.len() {
+                    let index = chunk * CHUNK + r;
+                    let qr = &q[index * dof..(index + 1) * dof];
+                    let f0 = wrench_of_row(f0, index);
+                    if let Err((kind, message)) = row(arm, data, qr, f0, choice, &mut part, r) {
+                        fail(&mut part, r, dof, cables);
+                        errors.push((index, kind, message));
+                    }
+                }
+                errors
+            },
+        )
+        .collect();
+    batch.errors = errors.into_iter().flatten().collect();
     batch
+}
+
+/// `buffer` (`rows × width`, row-major) cut into the tasks' blocks of [`CHUNK`] rows, one block
+/// per task even when `width` is 0 (an empty slice then).
+fn cut<T>(mut buffer: &mut [T], width: usize, rows: usize) -> impl Iterator<Item = &mut [T]> {
+    (0..rows.div_ceil(CHUNK)).map(move |task| {
+        let n = width * CHUNK.min(rows - task * CHUNK);
+        let (block, rest) = std::mem::take(&mut buffer).split_at_mut(n);
+        buffer = rest;
+        block
+    })
+}
+
+/// Row `r` of `part` as a failed row: NaN everywhere, `ok` and `stable` false.
+fn fail(part: &mut Part<'_>, r: usize, dof: usize, cables: usize) {
+    part.ok[r] = false;
+    part.stable[r] = false;
+    part.min_eigenvalue[r] = f64::NAN;
+    part.t0[r * dof..(r + 1) * dof].fill(f64::NAN);
+    part.tensions[r * cables..(r + 1) * cables].fill(f64::NAN);
+    part.c_x[r * 36..(r + 1) * 36].fill(f64::NAN);
+    part.k_x[r * 36..(r + 1) * 36].fill(f64::NAN);
+    part.k_fd[r * 9..(r + 1) * 9].fill(f64::NAN);
 }
 
 /// Row `r`'s wrench: the one wrench of every row, or its own.
@@ -147,59 +166,67 @@ pub fn wrench_of_row(f0: &[Vector6<f64>], r: usize) -> &Vector6<f64> {
     if f0.len() == 1 { &f0[0] } else { &f0[r] }
 }
 
-/// One row: the arm's checks (limits, finiteness) and evaluation, into `out`.
+/// One row: the arm's checks (limits, finiteness) and evaluation, written into row `r` of
+/// `part`; the error's kind and message when the row fails (the caller then fills it with NaN).
 fn row(
     arm: &ArmStiffness,
     data: &mut ArmStiffnessData,
     q: &[f64],
     f0: &Vector6<f64>,
     choice: &BatchChoice,
-    out: &mut Fixed,
-) {
-    let fail = |out: &mut Fixed, e: sinew::Error| {
-        out.error = Some(crate::errors::message(e));
-    };
+    part: &mut Part<'_>,
+    r: usize,
+) -> Result<(), (ErrorKind, String)> {
+    let fail = |e: sinew::Error| crate::errors::message(e);
     let choice = match choice {
         BatchChoice::Levels(levels) => TensionChoice::Levels(levels),
         BatchChoice::Policy(p) => TensionChoice::Policy(*p),
         BatchChoice::Default => TensionChoice::Default,
     };
     // The arm refuses angles outside the limits and NaN in its pose stage.
-    if let Err(e) = arm.evaluate_joints(data, q, f0, choice) {
-        return fail(out, e.into());
-    }
-    let end = match arm.solve_end(data) {
-        Ok(end) => end,
-        Err(e) => return fail(out, e.into()),
-    };
-    let Some(outcome) = data.outcome() else { return };
-    match outcome.margin() {
-        Ok(m) => out.min_eigenvalue = m,
-        Err(e) => return fail(out, e.into()),
-    }
+    arm.evaluate_joints(data, q, f0, choice).map_err(|e| fail(e.into()))?;
+    let end = arm.solve_end(data).map_err(|e| fail(e.into()))?;
+    let outcome = data
+        .outcome()
+        .ok_or_else(|| (ErrorKind::Numerical, String::from("the evaluation left no outcome")))?;
+    part.min_eigenvalue[r] = outcome.margin().map_err(|e| fail(e.into()))?;
     let (stable, full_rank) = (end.is_stable(), end.has_end_stiffness());
-    out.ok = true;
-    out.stable = stable;
+    part.ok[r] = true;
+    part.stable[r] = stable;
+    let (dof, cables) = (arm.dof(), arm.routing().cable_count());
+    part.t0[r * dof..(r + 1) * dof].copy_from_slice(&data.statics.t0);
+    part.tensions[r * cables..(r + 1) * cables].copy_from_slice(data.tensions());
+    let (c_x, k_x, k_fd) = (
+        &mut part.c_x[r * 36..][..36],
+        &mut part.k_x[r * 36..][..36],
+        &mut part.k_fd[r * 9..][..9],
+    );
     if stable {
         let c = data.compliance();
         for i in 0..6 {
             for j in 0..6 {
-                out.c_x[6 * i + j] = c[(i, j)];
+                c_x[6 * i + j] = c[(i, j)];
             }
         }
+    } else {
+        c_x.fill(f64::NAN);
     }
     if full_rank {
         let k = data.stiffness();
         for i in 0..6 {
             for j in 0..6 {
-                out.k_x[6 * i + j] = k[(i, j)];
+                k_x[6 * i + j] = k[(i, j)];
             }
         }
-        let k_fd = data.k_fd();
+        let k = data.k_fd();
         for i in 0..3 {
             for j in 0..3 {
-                out.k_fd[3 * i + j] = k_fd[(i, j)];
+                k_fd[3 * i + j] = k[(i, j)];
             }
         }
+    } else {
+        k_x.fill(f64::NAN);
+        k_fd.fill(f64::NAN);
     }
+    Ok(())
 }

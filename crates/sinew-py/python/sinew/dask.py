@@ -23,7 +23,9 @@ past one machine), or a ``distributed.Client``. With ``compute=False`` the field
 arrays (``errors`` a ``dask.delayed`` list) and nothing runs until ``result.compute()``;
 ``progress=True`` shows Dask's own progress bar while it runs. A row that fails is a row of
 the result (``ok`` False, NaN, its error in ``errors``); when every row fails, the first row's
-error is raised, as ``evaluate_many`` does.
+error is raised, as ``evaluate_many`` does. ``fields=["ok", "stable", "k_fd"]`` keeps only
+those fields (``ok`` always, and ``errors``): the workers send back only them, which is most of
+a map's cost when the results are large (a full cdhrm5 row is 1.2 kB, its ``k_fd`` 72 bytes).
 """
 
 from __future__ import annotations
@@ -88,19 +90,21 @@ class MapResult:
         return MapResult(dict(zip(self._names, client.gather(futures))))
 
 
-def _evaluate_chunk(arm, Q, wrench, offset, levels=None, policy=None):
-    """One task: ``evaluate_many`` on one chunk with ``threads=1``, errors renumbered."""
+def _evaluate_chunk(arm, Q, wrench, offset, names, levels=None, policy=None):
+    """One task: ``evaluate_many`` on one chunk with ``threads=1``, the fields ``names`` kept,
+    errors renumbered."""
     b = arm.evaluate_many(Q, wrench, levels=levels, policy=policy, threads=1,
                           raise_if_all_fail=False)
-    out = {name: getattr(b, name) for name in _EVALUATE}
+    out = {name: getattr(b, name) for name in names}
     out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
     return out
 
 
-def _plan_chunk(arm, Q, wrench, offset, options=None):
-    """One task: ``plan_many`` on one chunk with ``threads=1``, errors renumbered."""
+def _plan_chunk(arm, Q, wrench, offset, names, options=None):
+    """One task: ``plan_many`` on one chunk with ``threads=1``, the fields ``names`` kept,
+    errors renumbered."""
     b = arm.plan_many(Q, wrench, threads=1, raise_if_all_fail=False, **(options or {}))
-    out = {name: getattr(b, name) for name in _plan_fields(arm)}
+    out = {name: getattr(b, name) for name in names}
     out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
     return out
 
@@ -141,6 +145,22 @@ _PLAN = {
 
 def _plan_fields(arm):
     return {k: v for k, v in _PLAN.items() if k != "levels" or arm.has_levels}
+
+
+def _chosen(available: dict, fields: Any) -> dict:
+    """The fields a map returns: all of ``available`` (``fields`` None) or those named, in
+    the order given, ``ok`` first when it is not named (a result's length is its length)."""
+    if fields is None:
+        return dict(available)
+    if isinstance(fields, str) or not all(isinstance(f, str) for f in fields):
+        raise InputError(f"fields: expected a list of field names, got {fields!r}")
+    names = list(fields)
+    unknown = [f for f in names if f not in available]
+    if unknown:
+        raise InputError(f"fields: no field {unknown[0]!r}; the fields are {', '.join(available)}")
+    if "ok" not in names:
+        names.insert(0, "ok")
+    return {name: available[name] for name in dict.fromkeys(names)}
 
 
 def _rows(arm: ArmStiffness, Q: Any):
@@ -219,8 +239,8 @@ class _Session:
 
 
 def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
-    """Cut ``Q`` into chunks, run ``task(model, Q_chunk, wrench_chunk, offset)`` on each,
-    and stack the fields."""
+    """Cut ``Q`` into chunks, run ``task(model, Q_chunk, wrench_chunk, offset, names)`` on
+    each, and stack the fields."""
     if not isinstance(arm, ArmStiffness):
         raise InputError(f"arm: expected a sinew.ArmStiffness, got {type(arm).__name__}")
     chunk = DEFAULT_CHUNK if chunk is None else chunk
@@ -231,14 +251,17 @@ def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
     wrench, per_row = _wrench_rows(wrench, rows)
     session = _Session(client)
     try:
-        # The model, once per worker (it pickles by value); the tasks refer to it by key.
-        model = session.client.scatter(arm, broadcast=True)
+        # The model, once per worker (it pickles by value); the tasks refer to it by key. A
+        # key of its own per map (hash=False): two maps of one model in a row on one client
+        # would otherwise share the key, and the first's release could drop the second's data.
+        model = session.client.scatter(arm, broadcast=True, hash=False)
+        names = list(fields)
         starts = list(range(0, rows, int(chunk)))
         parts = []
         for a in starts:
             b = min(a + int(chunk), rows)
             w = _block(wrench, a, b) if per_row else wrench
-            parts.append((a, b, dask.delayed(task, pure=True)(model, _block(Q, a, b), w, a)))
+            parts.append((a, b, dask.delayed(task, pure=True)(model, _block(Q, a, b), w, a, names)))
         if compute:
             futures = session.client.compute([p for _, _, p in parts])
             if progress:
@@ -282,10 +305,13 @@ def map_evaluate(
     client: Any = None,
     compute: bool = True,
     progress: bool = False,
+    fields: Optional[list] = None,
 ) -> MapResult:
     """``arm.evaluate_many(Q, wrench, levels=…, policy=…)`` on a Dask cluster, chunk by chunk
     (``threads=1`` per chunk): the same fields, bit for bit, failed rows included. ``Q`` is
-    (N, dof), a numpy or dask array; ``wrench`` one (6,) for every row or (N, 6)."""
+    (N, dof), a numpy or dask array; ``wrench`` one (6,) for every row or (N, 6); ``fields``
+    the names of ``BatchResult``'s fields to keep (None: all)."""
+    chosen = _chosen(_EVALUATE, fields)
     Q = _rows(arm, Q)
     if levels is not None:
         levels = np.asarray(levels, dtype=np.float64)
@@ -295,7 +321,7 @@ def map_evaluate(
                       levels=levels, policy=policy, threads=1)
 
     return _run(arm, Q, wrench, chunk, client, compute, progress,
-                functools.partial(_evaluate_chunk, levels=levels, policy=policy), _EVALUATE)
+                functools.partial(_evaluate_chunk, levels=levels, policy=policy), chosen)
 
 
 def map_plan(
@@ -306,11 +332,14 @@ def map_plan(
     client: Any = None,
     compute: bool = True,
     progress: bool = False,
+    fields: Optional[list] = None,
     **options: Any,
 ) -> MapResult:
     """``arm.plan_many(Q, wrench, **options)`` on a Dask cluster, chunk by chunk (``threads=1``
     per chunk): the same fields, bit for bit, failed rows included. ``options`` are
-    ``plan``'s (``objective``, ``direction``, ``k_min``, ``margin``, ``budget``, …)."""
+    ``plan``'s (``objective``, ``direction``, ``k_min``, ``margin``, ``budget``, …); ``fields``
+    the names of ``PlanBatchResult``'s fields to keep (None: all)."""
+    chosen = _chosen(_plan_fields(arm), fields)
     for bad in ("threads", "raise_if_all_fail"):
         if bad in options:
             raise InputError(f"{bad}: map_plan sets it (threads=1 per chunk)")
@@ -319,4 +348,4 @@ def map_plan(
     arm.plan_many(np.zeros((0, arm.dof)), None if w is None or per_row else w, threads=1,
                   **options)
     return _run(arm, Q, wrench, chunk, client, compute, progress,
-                functools.partial(_plan_chunk, options=options), _plan_fields(arm))
+                functools.partial(_plan_chunk, options=options), chosen)
