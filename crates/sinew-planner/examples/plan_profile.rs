@@ -1,0 +1,53 @@
+//! Runs `N` certified plans of one objective on cdhrm5 at the loaded pose under 5 N along y,
+//! for instruction counts (`scripts/planner-instructions`: callgrind with 0 and N plans, the
+//! difference divided by N), and prints the iterations and the value of the last plan.
+//!
+//! `cargo run --release -p sinew-planner --example plan_profile -- MODEL OBJECTIVE N METHOD`
+//! with MODEL `decoupled` or `routed`, OBJECTIVE one of `stiffness-along`, `compliance-along`,
+//! `min-stiffness`, `volume`, `least-tension`, and METHOD `ipm` or `bundle`.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use std::hint::black_box;
+
+use nalgebra::{Vector3, Vector6};
+use sinew_planner::{Method, Objective, PlanSettings, Planner, PlannerData, Requirements};
+use sinew_routing::PatternModel;
+use sinew_stiffness::ArmStiffness;
+use sinew_testkit::cdhrm5;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let model = match args.get(1).map(String::as_str) {
+        Some("routed") => PatternModel::Routed,
+        _ => PatternModel::Decoupled,
+    };
+    let objective = match args.get(2).map(String::as_str).unwrap_or("stiffness-along") {
+        "compliance-along" => Objective::ComplianceAlong(Vector3::y()),
+        "min-stiffness" => Objective::MinStiffness,
+        "volume" => Objective::Volume,
+        "least-tension" => Objective::LeastTension,
+        _ => Objective::StiffnessAlong(Vector3::y()),
+    };
+    let plans: usize = args.get(3).map_or(1, |n| n.parse().expect("N plans"));
+    let method = match args.get(4).map(String::as_str) {
+        Some("bundle") => Method::Bundle,
+        _ => Method::InteriorPoint,
+    };
+    let (robot, routing) = cdhrm5::robot_and_routing(model);
+    let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+    let mut data = PlannerData::new(&planner);
+    let q = cdhrm5::LOADED_POSE;
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let requirements = Requirements::default();
+    let settings = PlanSettings { method, ..PlanSettings::default() };
+    let mut last = None;
+    for _ in 0..plans {
+        let plan = planner
+            .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
+            .unwrap();
+        last = Some((plan.iterations, plan.value));
+    }
+    if let Some((iterations, value)) = last {
+        println!("{iterations} iterations, value {value:.9e}");
+    }
+}
