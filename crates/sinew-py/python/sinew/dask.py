@@ -266,14 +266,21 @@ def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
             futures = session.client.compute([p for _, _, p in parts])
             if progress:
                 distributed.progress(futures)
-            done = session.client.gather(futures)
-            out = {}
-            for name, (shape, dtype) in fields.items():
-                if done:
-                    out[name] = np.concatenate([d[name] for d in done])
-                else:
-                    out[name] = np.zeros((0, *shape(arm)), dtype=dtype)
-            out["errors"] = _all_errors(*[d["errors"] for d in done])
+            # Each chunk's result fetched as soon as its task ends (while the others run) and
+            # copied into its rows, then let go on the worker: no gather at the end, no
+            # concatenation.
+            out = {name: np.empty((rows, *shape(arm)), dtype=dtype)
+                   for name, (shape, dtype) in fields.items()}
+            errors = [[] for _ in parts]
+            chunk_of = {f.key: i for i, f in enumerate(futures)}
+            for future, done in distributed.as_completed(futures, with_results=True):
+                i = chunk_of[future.key]
+                a, b, _ = parts[i]
+                for name in fields:
+                    out[name][a:b] = done[name]
+                errors[i] = done["errors"]
+                future.release()
+            out["errors"] = _all_errors(*errors)
             if rows and len(out["errors"]) == rows:
                 # As evaluate_many / plan_many: a map whose every row failed raises.
                 _, kind, message = out["errors"][0]
