@@ -47,6 +47,35 @@ def test_bad_rows_are_flagged(robot, arm):
     assert np.all(np.isnan(b.t0[1])) and np.all(np.isnan(b.c_x[2]))
 
 
+def test_every_field_of_failed_and_rank_deficient_rows(arm):
+    # The buffers start zeroed and each row writes every entry once: a field a failed row left
+    # unwritten would read 0.0 here, not NaN.
+    Q = np.zeros((5, 10))
+    Q[1, 3] = np.nan
+    Q[2, 0] = 3.0
+    Q[3] = E4_Q
+    Q[4] = E4_Q
+    b = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5)
+    floats = ["min_eigenvalue", "t0", "tensions", "c_x", "k_x", "k_fd"]
+    for r in (1, 2):
+        assert not b.ok[r] and not b.stable[r]
+        for name in floats:
+            assert np.all(np.isnan(getattr(b, name)[r])), (r, name)
+    # Row 0, the straight arm: evaluated and stable, J_x rank-deficient: C_x finite, K_x and
+    # K_fd NaN, as evaluate(...) gives None for them.
+    one = arm.evaluate(Q[0], E4_F0, levels=[0.5] * 5)
+    assert b.ok[0] and b.stable[0] == one.stable
+    assert one.k_x is None
+    assert np.all(np.isfinite(b.c_x[0])) and np.all(np.isnan(b.k_x[0]))
+    assert np.all(np.isnan(b.k_fd[0]))
+    close(b.t0[0], one.t0, 0)
+    # Rows 3 and 4, the same pose: every entry finite and equal, written by the same code.
+    for name in floats:
+        a = getattr(b, name)
+        assert np.all(np.isfinite(a[3])), name
+        assert a[3].tobytes() == a[4].tobytes(), name
+
+
 def test_all_bad_rows_raise(arm):
     with pytest.raises(sinew.InputError, match="every row failed"):
         arm.evaluate_many(np.full((3, 10), 3.0))
