@@ -2,7 +2,7 @@
 //! element starts (counted by hand in the texts below).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use sinew_import::{ImportError, ImportOptions, Place, Source, import_caspr};
+use sinew_import::{ImportError, ImportOptions, Place, Source, import_caspr, read_caspr};
 
 /// A one-link bodies file; `joint`, `mass` and `parent` are spliced into lines 3, 5 and 8.
 fn bodies(joint: &str, mass: &str, parent: &str) -> String {
@@ -398,4 +398,68 @@ fn a_file_that_cannot_be_read_or_written_is_named() {
     let e = folder.write_into(&dir.join("not-there")).unwrap_err();
     let ImportError::Io { path, .. } = &e else { panic!("{e:?}") };
     assert!(path.starts_with(dir.join("not-there")), "{e}");
+}
+
+fn read(bodies: &str) -> Result<sinew_import::CasprModel, ImportError> {
+    read_caspr(
+        Source { name: "b.xml", text: bodies },
+        Source { name: "c.xml", text: CABLES },
+        None,
+        None,
+    )
+}
+
+#[test]
+fn limits_say_how_many_numbers_a_joint_of_one_or_two_coordinates_takes() {
+    // R_Y with "-1 -1": one number expected; U_XY with "-1": two.
+    let e = read(&bodies("R_Y", "0.2", "0")).unwrap_err();
+    assert!(
+        matches!(&e, ImportError::InvalidNumber { expected: "one finite number (rad)", .. }),
+        "{e:?}"
+    );
+    let one = bodies("U_XY", "0.2", "0").replace(r#"q_min="-1 -1""#, r#"q_min="-1""#);
+    let e = read(&one).unwrap_err();
+    match &e {
+        ImportError::InvalidNumber { field, text, expected, .. } => {
+            assert_eq!((field.as_str(), text.as_str()), ("q_min", "-1"));
+            assert_eq!(*expected, "two finite numbers (rad)");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn blank_limits_are_absent_and_equal_limits_are_a_locked_joint() {
+    // A blank q_min / q_max is no limit: ±π, and the limits are marked as not stated.
+    let blank = bodies("U_XY", "0.2", "0")
+        .replace(r#"q_min="-1 -1""#, r#"q_min="  ""#)
+        .replace(r#"q_max="1 1""#, r#"q_max="""#);
+    let link = &read(&blank).unwrap().links[0];
+    let pi = std::f64::consts::PI;
+    assert_eq!((link.q_min.as_slice(), link.q_max.as_slice()), (&[-pi, -pi][..], &[pi, pi][..]));
+    assert!(!link.limits_stated);
+    // Stated limits are kept as written; lower = upper (a locked coordinate) is not inverted.
+    let locked = bodies("U_XY", "0.2", "0").replace(r#"q_max="1 1""#, r#"q_max="1 -1""#);
+    let link = &read(&locked).unwrap().links[0];
+    assert_eq!(
+        (link.q_min.as_slice(), link.q_max.as_slice()),
+        (&[-1.0, -1.0][..], &[1.0, -1.0][..])
+    );
+    assert!(link.limits_stated);
+}
+
+#[test]
+fn a_negative_mass_is_refused_and_a_massless_link_is_not() {
+    let e = read(&bodies("U_XY", "-0.1", "0")).unwrap_err();
+    match &e {
+        ImportError::InvalidNumber { field, text, expected, .. } => {
+            assert_eq!(
+                (field.as_str(), text.as_str(), *expected),
+                ("<mass>", "-0.1", "a mass ≥ 0 kg")
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(at(&e), ("b.xml", 5, 9));
+    assert_eq!(read(&bodies("U_XY", "0", "0")).unwrap().links[0].mass, 0.0);
 }
