@@ -90,6 +90,9 @@ fn a_missing_parent_and_a_tree_are_errors() {
     let e = run(&bodies("U_XY", "0.2", "4"), CABLES, None);
     assert!(matches!(&e, ImportError::MissingParent { link: 1, parent: 4, links: 1, .. }), "{e:?}");
     assert_eq!(at(&e), ("b.xml", 8, 7));
+    // Its own number (the last link's) is a link that exists, but not the previous one.
+    let e = run(&bodies("U_XY", "0.2", "1"), CABLES, None);
+    assert!(matches!(&e, ImportError::NotSerial { link: 1, parent: 1, expected: 0, .. }), "{e:?}");
 
     // Link 2 hangs from the base: not the previous link.
     let two = bodies("U_XY", "0.2", "0").replace(
