@@ -595,7 +595,7 @@ fn a_load_beyond_the_limits_is_refused_naming_the_joint() {
     // The snake straight, F0 = 60 N along +y (the tip pressing down on a surface, which pushes
     // it up): the +y cables must pull. Joint 1 then needs 53.6 N m from its cables (all nine
     // cross it at 18 or 10 mm), which give at most 41.6 N m within [20, 600] N; joints 2–4
-    // hold. The certificate names joint 1 alone, its joint motion [1, 0, 0, 0].
+    // hold. The certificate names joint 1 alone, its joint motion [-1, 0, 0, 0] (T0 · δq = 53.6).
     let (robot, routing) = load_robot("planar-snake");
     let load = Vector6::new(0.0, 60.0, 0.0, 0.0, 0.0, 0.0);
     for policy in TensionPolicy::ALL {

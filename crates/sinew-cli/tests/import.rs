@@ -367,9 +367,9 @@ fn arm_refuses_a_twist_that_no_tensions_hold() {
              [5, 300] N: no tensions within the limits hold the torque (λ ≥ {lo:.3} and λ ≤ {hi:.3})"
         )
     );
-    // A policy's certificate: along the joint motion d, the cables give J_cᵀ f · d (the sign
-    // of J_cᵀ f = −T0) only within a range, over f ∈ [5, 300]³, that misses the 0 N m the load
-    // needs. Checked against the geometry's J_c.
+    // A policy's certificate: along the joint motion d, the cables' torque −J_cᵀ f · d (the
+    // sign of T0) has only a range, over f ∈ [5, 300]³, that misses the 0 N m the load needs.
+    // Checked against the geometry's J_c: `along` is J_c (−d), the cables' weights.
     let mut args = base.to_vec();
     args.extend(["--policy", "least-norm"]);
     let line = fails(&args, 1);
@@ -383,7 +383,7 @@ fn arm_refuses_a_twist_that_no_tensions_hold() {
     let (d, range) = (parse(d), parse(range));
     assert_eq!(d[..2], [0.0, 0.0], "{line}");
     assert_eq!(d.iter().fold(0.0_f64, |m, x| m.max(x.abs())), 1.0, "largest component 1: {line}");
-    let along: Vec<f64> = (0..3).map(|c| a2[(0, c)] * d[2] + a2[(1, c)] * d[3]).collect();
+    let along: Vec<f64> = (0..3).map(|c| -(a2[(0, c)] * d[2] + a2[(1, c)] * d[3])).collect();
     let [min, max] = [5.0, 300.0]
         .map(|up| along.iter().map(|&x| x * if x > 0.0 { up } else { 305.0 - up }).sum::<f64>());
     let near = |got: f64, want: f64| (got / want - 1.0).abs() < 1e-4;

@@ -316,9 +316,10 @@ pub enum NoEquilibriumCause {
         torque: f64,
     },
     /// The cables could balance the load, but not within their limits. Along the joint motion
-    /// `direction` (largest component 1) every balancing tension vector gives the same torque
-    /// `needed` (N m), while tensions within the limits give only `range` (N m): the
-    /// solver's certificate of infeasibility. Reaching `needed` would take the cables
+    /// `direction` (largest component 1) every balancing tension vector gives the same cable
+    /// torque `needed = T0 · direction` (N m; the cables' torque is `τ = −J_cᵀ f`), while
+    /// tensions within the limits give only `range` (N m): the solver's certificate of
+    /// infeasibility. Reaching `needed` would take the cables
     /// `at_max` beyond `f_max` or the cables `at_min` below `f_min`.
     Limits {
         /// The joint motion (largest component 1).

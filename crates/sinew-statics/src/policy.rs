@@ -364,6 +364,10 @@ fn limits_certificate(
             .map(|c| names.get(c).cloned().unwrap_or_else(|| format!("#{}", c + 1)))
             .collect()
     };
+    // `w · f = (J_cᵀ f) · δq` is minus the cables' torque `τ = −J_cᵀ f` along `δq`: the
+    // numbers above are the cables' torque along `−δq`, which is the joint motion reported
+    // (the sign of `T0`, as `NoEquilibriumCause::Unreachable` reports it).
+    direction.iter_mut().for_each(|v| *v = if *v == 0.0 { 0.0 } else { -*v });
     StaticsError::NoEquilibrium(Box::new(NoEquilibrium {
         joints: joints_along(&direction, groups),
         cause: NoEquilibriumCause::Limits {

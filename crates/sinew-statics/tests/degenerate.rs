@@ -71,7 +71,8 @@ fn a_set_without_null_space_has_its_unique_tensions_under_every_policy() {
         assert_eq!((d.iterations, d.lambda.len()), (0, 0));
     }
     // 1000 N on cable 1: refused along DOF 1 alone, joint 1 named, with the numbers per unit
-    // of joint motion: the load needs 20 N m, the cable gives [0.4, 12] N m.
+    // of joint motion: along δq = −1 the load needs T0 · δq = 20 N m, the cable's torque
+    // −J_cᵀ f · δq = 0.02 m × f gives [0.4, 12] N m.
     let t0 = [-20.0, -0.6];
     let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 2], &groups).unwrap();
     for (policy, outcome) in solve_all(&set, &groups) {
@@ -86,7 +87,7 @@ fn a_set_without_null_space_has_its_unique_tensions_under_every_policy() {
         assert!((needed - 20.0).abs() <= 1e-12, "{policy:?}: needed {needed}");
         assert!((range[0] - 0.4).abs() <= 1e-12 && (range[1] - 12.0).abs() <= 1e-12, "{range:?}");
         assert_eq!((at_max.clone(), at_min.clone()), (vec!["c1".to_owned()], vec![]));
-        assert_eq!(direction, &vec![1.0, 0.0]);
+        assert_eq!(direction, &vec![-1.0, 0.0]);
         let message = StaticsError::NoEquilibrium(why).to_string();
         assert!(message.contains("joint 1") && message.contains("c1"), "{message}");
     }
@@ -167,8 +168,9 @@ fn one_cable_alone_holds_a_torque_that_pulls_it() {
         let NoEquilibriumCause::Limits { needed, range, at_min, direction, .. } = &why.cause else {
             panic!("{why}")
         };
-        // Along δq = −1 the load needs 1 N m; the cable gives −0.02 m × [20, 600] N.
-        assert_eq!(direction, &vec![-1.0], "{why}");
+        // Along δq = +1 the load needs T0 · δq = 1 N m; the cable's torque −J_cᵀ f · δq gives
+        // −0.02 m × [20, 600] N.
+        assert_eq!(direction, &vec![1.0], "{why}");
         assert_eq!(at_min, &vec!["c1".to_owned()], "{why}");
         assert!((needed - 1.0).abs() <= 1e-12, "{why}");
         assert!((range[0] + 12.0).abs() <= 1e-12 && (range[1] + 0.4).abs() <= 1e-12, "{why}");
