@@ -19,9 +19,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{DMatrix, DVector, Vector6};
-use sinew::robot::{Robot, RobotData};
-use sinew::routing::{Order, Routing, RoutingData, compute_cable_geometry};
-use sinew::statics::{ArmStatics, StaticsError, TensionChoice, TensionPolicy};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::{ArmStatics, StaticsError, TensionChoice, TensionPolicy};
 use sinew_testkit::cdhrm5;
 use sinew_testkit::random_chain::RandomChain;
 
@@ -36,8 +36,8 @@ struct Case {
 
 fn load(name: &str) -> (Robot, Routing) {
     let dir = cdhrm5::workspace_root().join("robots").join(name);
-    let robot = sinew::robot::load(&dir).unwrap();
-    let routing = sinew::routing::load(&dir, &robot).unwrap();
+    let robot = sinew_robot::load(&dir).unwrap();
+    let routing = sinew_routing::load(&dir, &robot).unwrap();
     (robot, routing)
 }
 
