@@ -8,63 +8,221 @@
 //! that is not positive and finite, which is how the method tests `S ≻ 0` (its "Cholesky
 //! trials") instead of computing eigenvalues. Tested against faer's `llt` below.
 
+/// `Σ a_i b_i` over the shorter of the two, with four accumulators (so that the loop
+/// vectorises and pipelines; the order of the additions is fixed, so results repeat).
+#[inline(always)]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0; 4];
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            acc[i] += x[i] * y[i];
+        }
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// `y ← y + α x` over the shorter of the two.
+#[inline(always)]
+pub(crate) fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (o, v) in y.iter_mut().zip(x) {
+        *o += alpha * v;
+    }
+}
+
+/// Calls `$f::<N>` for the block sizes that have a fixed-size kernel (every `n ≤ 17`: an arm of
+/// up to 16 DOF, its bordered compliance block included), else runs `$dynamic`.
+macro_rules! fixed_size {
+    ($n:expr, $f:ident($($arg:expr),*), $dynamic:expr) => {
+        match $n {
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            9 => $f::<9>($($arg),*),
+            10 => $f::<10>($($arg),*),
+            11 => $f::<11>($($arg),*),
+            12 => $f::<12>($($arg),*),
+            13 => $f::<13>($($arg),*),
+            14 => $f::<14>($($arg),*),
+            15 => $f::<15>($($arg),*),
+            16 => $f::<16>($($arg),*),
+            17 => $f::<17>($($arg),*),
+            _ => $dynamic,
+        }
+    };
+}
+
 /// Overwrite the lower triangle of the symmetric `a` (n × n) with its Cholesky factor `L`
 /// (`a = L Lᵀ`); the strict upper triangle is left as it was. `false` (and `a` spoilt) when
 /// `a` is not positive definite to working precision.
+///
+/// Row-oriented (each entry of `L` the dot product of two row prefixes), the arithmetic of
+/// Algorithm 4.2.1 of Golub and Van Loan; fixed-size kernels up to n = 17.
+#[inline(always)]
 pub(crate) fn cholesky(a: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let mut d = a[j * n + j];
+    fixed_size!(n, cholesky_fixed(a), cholesky_dynamic(a, n))
+}
+
+#[inline(always)]
+fn cholesky_fixed<const N: usize>(a: &mut [f64]) -> bool {
+    let (rows, _) = a[..N * N].as_chunks_mut::<N>();
+    for j in 0..N {
+        let row_j = rows[j];
+        let mut d = row_j[j];
         for p in 0..j {
-            d -= a[j * n + p] * a[j * n + p];
+            d -= row_j[p] * row_j[p];
         }
         if !(d > 0.0 && d.is_finite()) {
             return false;
         }
         let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut v = a[i * n + j];
+        rows[j][j] = d;
+        let inv = 1.0 / d;
+        for row_i in rows[j + 1..].iter_mut() {
+            let mut v = row_i[j];
             for p in 0..j {
-                v -= a[i * n + p] * a[j * n + p];
+                v -= row_i[p] * row_j[p];
             }
-            a[i * n + j] = v / d;
+            row_i[j] = v * inv;
         }
     }
     true
 }
 
-/// Solve `L Lᵀ x = b` in place (`l` from [`cholesky`]).
+fn cholesky_dynamic(a: &mut [f64], n: usize) -> bool {
+    let a = &mut a[..n * n];
+    for j in 0..n {
+        let (head, tail) = a.split_at_mut((j + 1) * n);
+        let row_j = &mut head[j * n..j * n + n];
+        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        let d = d.sqrt();
+        row_j[j] = d;
+        let inv = 1.0 / d;
+        let row_j = &row_j[..j];
+        for row_i in tail.chunks_exact_mut(n) {
+            row_i[j] = (row_i[j] - dot(&row_i[..j], row_j)) * inv;
+        }
+    }
+    true
+}
+
+/// Solve `L Lᵀ x = b` in place (`l` from [`cholesky`]): forward by rows of `L`, backward by
+/// the same rows (`Lᵀ`'s columns); fixed-size kernels up to n = 17.
+#[inline(always)]
 pub(crate) fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
-    for i in 0..n {
+    fixed_size!(n, cholesky_solve_fixed(l, b), cholesky_solve_dynamic(l, n, b))
+}
+
+#[inline(always)]
+fn cholesky_solve_fixed<const N: usize>(l: &[f64], b: &mut [f64]) {
+    let (rows, _) = l[..N * N].as_chunks::<N>();
+    let b = &mut b[..N];
+    for i in 0..N {
         let mut v = b[i];
         for p in 0..i {
-            v -= l[i * n + p] * b[p];
+            v -= rows[i][p] * b[p];
         }
-        b[i] = v / l[i * n + i];
+        b[i] = v / rows[i][i];
     }
-    for i in (0..n).rev() {
-        let mut v = b[i];
-        for p in i + 1..n {
-            v -= l[p * n + i] * b[p];
+    for i in (0..N).rev() {
+        let v = b[i] / rows[i][i];
+        b[i] = v;
+        for p in 0..i {
+            b[p] -= v * rows[i][p];
         }
-        b[i] = v / l[i * n + i];
     }
 }
 
-/// `out = (L Lᵀ)⁻¹`, full and symmetric (`l` from [`cholesky`]); `column` is scratch of n.
-pub(crate) fn cholesky_inverse(l: &[f64], n: usize, out: &mut [f64], column: &mut [f64]) {
-    for c in 0..n {
-        column[..n].fill(0.0);
-        column[c] = 1.0;
-        cholesky_solve(l, n, &mut column[..n]);
-        for r in 0..n {
-            out[r * n + c] = column[r];
-        }
+fn cholesky_solve_dynamic(l: &[f64], n: usize, b: &mut [f64]) {
+    let b = &mut b[..n];
+    for i in 0..n {
+        let row = &l[i * n..i * n + i];
+        b[i] = (b[i] - dot(row, &b[..i])) / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let row = &l[i * n..i * n + i];
+        let v = b[i] / l[i * n + i];
+        b[i] = v;
+        axpy(-v, row, &mut b[..i]);
+    }
+}
+
+/// `out = (L Lᵀ)⁻¹ = L⁻ᵀ L⁻¹`, full and symmetric (`l` from [`cholesky`]): `T = L⁻¹` row by
+/// row (`T_i = (e_i − Σ_{p<i} L_ip T_p) / L_ii`) into the scratch `t` (n × n), then `Tᵀ T` by
+/// a matrix product.
+#[inline(always)]
+pub(crate) fn cholesky_inverse(l: &[f64], n: usize, out: &mut [f64], t: &mut [f64]) {
+    fixed_size!(n, lower_inverse_fixed(l, t), lower_inverse_dynamic(l, n, t));
+    let t = faer::MatRef::from_row_major_slice(&t[..n * n], n, n);
+    {
+        let out = faer::MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
+        faer::linalg::matmul::matmul(
+            out,
+            faer::Accum::Replace,
+            t.transpose(),
+            t,
+            1.0,
+            faer::Par::Seq,
+        );
     }
     symmetrise(out, n);
 }
 
+#[inline(always)]
+fn lower_inverse_fixed<const N: usize>(l: &[f64], t: &mut [f64]) {
+    let (l, _) = l[..N * N].as_chunks::<N>();
+    let (t, _) = t[..N * N].as_chunks_mut::<N>();
+    for i in 0..N {
+        let mut row = [0.0; N];
+        for p in 0..i {
+            let lip = l[i][p];
+            for c in 0..=p {
+                row[c] -= lip * t[p][c];
+            }
+        }
+        let inv = 1.0 / l[i][i];
+        for v in &mut row[..i] {
+            *v *= inv;
+        }
+        row[i] = inv;
+        t[i] = row;
+    }
+}
+
+fn lower_inverse_dynamic(l: &[f64], n: usize, t: &mut [f64]) {
+    let t = &mut t[..n * n];
+    t.fill(0.0);
+    for i in 0..n {
+        let (done, rest) = t.split_at_mut(i * n);
+        let row = &mut rest[..n];
+        for p in 0..i {
+            axpy(-l[i * n + p], &done[p * n..p * n + p + 1], &mut row[..p + 1]);
+        }
+        let inv = 1.0 / l[i * n + i];
+        for v in &mut row[..i] {
+            *v *= inv;
+        }
+        row[i] = inv;
+    }
+}
+
 /// `a ← ½ (a + aᵀ)`.
+#[inline(always)]
 pub(crate) fn symmetrise(a: &mut [f64], n: usize) {
     for r in 0..n {
         for c in r + 1..n {
@@ -75,27 +233,30 @@ pub(crate) fn symmetrise(a: &mut [f64], n: usize) {
     }
 }
 
+/// `out = a b` (all n × n, row-major): faer's matrix product, whose small-size kernels
+/// (nano-gemm, dispatched per instruction set) serve these 5–20-row blocks.
+pub(crate) fn multiply_fast(a: &[f64], b: &[f64], n: usize, out: &mut [f64]) {
+    let a = faer::MatRef::from_row_major_slice(&a[..n * n], n, n);
+    let b = faer::MatRef::from_row_major_slice(&b[..n * n], n, n);
+    let out = faer::MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
+    faer::linalg::matmul::matmul(out, faer::Accum::Replace, a, b, 1.0, faer::Par::Seq);
+}
+
 /// `out = a b` (all n × n).
+#[cfg(test)]
 pub(crate) fn multiply(a: &[f64], b: &[f64], n: usize, out: &mut [f64]) {
     out[..n * n].fill(0.0);
     for r in 0..n {
         for p in 0..n {
-            let v = a[r * n + p];
-            if v == 0.0 {
-                continue;
-            }
-            let row = &b[p * n..p * n + n];
-            let target = &mut out[r * n..r * n + n];
-            for (t, x) in target.iter_mut().zip(row) {
-                *t += v * x;
-            }
+            axpy(a[r * n + p], &b[p * n..p * n + n], &mut out[r * n..r * n + n]);
         }
     }
 }
 
 /// `⟨a, b⟩ = tr(aᵀ b)`.
+#[inline(always)]
 pub(crate) fn inner(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    dot(a, b)
 }
 
 #[cfg(test)]
@@ -124,7 +285,7 @@ mod tests {
 
     #[test]
     fn cholesky_matches_faer_and_solves_and_inverts() {
-        for (n, seed) in [(1, 1), (3, 2), (10, 3), (37, 4)] {
+        for (n, seed) in [(1, 1), (3, 2), (10, 3), (17, 5), (18, 6), (37, 4)] {
             let a = spd(n, seed);
             let mut l = a.clone();
             assert!(cholesky(&mut l, n));
@@ -143,14 +304,54 @@ mod tests {
             let error = b.iter().zip(&x_true).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
             assert!(error <= 1e-9, "n = {n}: solve error {error}");
             let mut inv = vec![0.0; n * n];
-            let mut column = vec![0.0; n];
-            cholesky_inverse(&l, n, &mut inv, &mut column);
+            let mut scratch = vec![0.0; n * n];
+            cholesky_inverse(&l, n, &mut inv, &mut scratch);
             let mut product = vec![0.0; n * n];
             multiply(&a, &inv, n, &mut product);
             for r in 0..n {
                 for c in 0..n {
                     let expected = if r == c { 1.0 } else { 0.0 };
                     assert!((product[r * n + c] - expected).abs() <= 1e-8);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_fast_product_is_the_plain_product_and_both_inverses_agree() {
+        for n in [1, 4, 10, 11, 17, 18, 23] {
+            let (a, b) = (spd(n, 7), spd(n, 8));
+            // Not symmetric: a row-scaled copy.
+            let a: Vec<f64> =
+                a.iter().enumerate().map(|(e, v)| v * (1.0 + (e / n) as f64)).collect();
+            let (mut plain, mut fast) = (vec![0.0; n * n], vec![0.0; n * n]);
+            multiply(&a, &b, n, &mut plain);
+            multiply_fast(&a, &b, n, &mut fast);
+            for (p, f) in plain.iter().zip(&fast) {
+                assert!((p - f).abs() <= 1e-12 * (1.0 + p.abs()), "n = {n}: {p} vs {f}");
+            }
+            // The fixed-size and the dynamic lower inverse (n ≤ 17 has both).
+            let mut l = b.clone();
+            assert!(cholesky(&mut l, n));
+            let mut dynamic = vec![0.0; n * n];
+            lower_inverse_dynamic(&l, n, &mut dynamic);
+            let mut product = vec![0.0; n * n];
+            for r in 0..n {
+                for c in 0..n {
+                    product[r * n + c] = (0..=r).map(|p| l[r * n + p] * dynamic[p * n + c]).sum();
+                }
+            }
+            for r in 0..n {
+                for c in 0..n {
+                    let expected = if r == c { 1.0 } else { 0.0 };
+                    assert!((product[r * n + c] - expected).abs() <= 1e-10, "n = {n}: L T ≠ I");
+                }
+            }
+            if n <= 17 {
+                let mut fixed = vec![0.0; n * n];
+                fixed_size!(n, lower_inverse_fixed(&l, &mut fixed), unreachable!());
+                for (x, y) in fixed.iter().zip(&dynamic) {
+                    assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()));
                 }
             }
         }

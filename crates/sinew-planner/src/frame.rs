@@ -98,11 +98,22 @@ impl Frame {
             .zip(&width)
             .map(|(&i, w)| {
                 let a = &pencil.ai[i];
-                (0..n * n).map(|e| w * 0.5 * (a[(e / n, e % n)] + a[(e % n, e / n)])).collect()
+                let mut out = vec![0.0; n * n];
+                for r in 0..n {
+                    for c in 0..n {
+                        out[r * n + c] = w * 0.5 * (a[(r, c)] + a[(c, r)]);
+                    }
+                }
+                out
             })
             .collect();
         let a_scale = (0..n).map(|i| a0[i * n + i].abs()).fold(0.0, f64::max).max(1e-12);
-        let j_x = (0..6 * n).map(|e| pencil.j_x[(e / n, e % n)]).collect();
+        let mut j_x = vec![0.0; 6 * n];
+        for r in 0..6 {
+            for c in 0..n {
+                j_x[r * n + c] = pencil.j_x[(r, c)];
+            }
+        }
         let k = free.len();
         let (mut rows, mut rhs) = (Vec::new(), Vec::new());
         for (row, h) in linear.rows.iter().zip(&linear.rhs) {

@@ -79,6 +79,17 @@ impl<'a> Interior<'a> {
         DMatrix::from_row_slice(n, n, &a).symmetric_eigenvalues().min()
     }
 
+    /// Whether `λ_min(A(x)) > m`: one Cholesky trial of `A(x) − m I`.
+    fn margin_exceeds(&self, x: &[f64], m: f64) -> bool {
+        let n = self.frame.n;
+        let mut a = vec![0.0; n * n];
+        self.frame.a_at(x, &mut a);
+        for i in 0..n {
+            a[i * n + i] -= m;
+        }
+        crate::dense::cholesky(&mut a, n)
+    }
+
     /// `K_x` at `x` (`None` where `A ⊁ 0` or `J_x` has rank < 6).
     fn k_x_at(&self, x: &[f64]) -> Option<nalgebra::Matrix6<f64>> {
         EndObjective::new(self.frame, Kind::Volume, 1.0).end_at(x).map(|e| e.k_x)
@@ -140,6 +151,9 @@ impl<'a> Interior<'a> {
     pub(crate) fn stable(&self, x: Vec<f64>) -> Result<(Vec<f64>, usize), PlanError> {
         let f = self.frame;
         let m = self.requirements.margin;
+        if self.margin_exceeds(&x, m) {
+            return Ok((x, 0));
+        }
         let now = self.margin_at(&x);
         if now > m {
             return Ok((x, 0));

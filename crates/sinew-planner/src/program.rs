@@ -133,31 +133,36 @@ pub(crate) enum End {
 
 /// The certified upper bound at `x` with `(y, Z)` (module docs), given the slacks `s` and the
 /// blocks' values `S_j` (row-major).
-pub(crate) fn upper_bound(
+pub(crate) fn upper_bound<'m>(
     sdp: &Sdp,
     x: &[f64],
     value: f64,
     gradient: &[f64],
     s: &[f64],
-    slack_matrices: &[&[f64]],
+    slack_matrices: impl Iterator<Item = &'m [f64]>,
     duals: &Duals,
 ) -> f64 {
     let k = sdp.vars();
-    let mut scales = vec![1.0; sdp.blocks.len()];
     let dual_term = |a: usize, j: usize, z: &[f64]| -> f64 {
         sdp.blocks[j].coefficients[a].as_ref().map_or(0.0, |f| inner(f, z))
     };
+    // The epigraph block's scale κ (every other block's is 1).
+    let mut epigraph = None;
     if let Some((t, j)) = sdp.epigraph {
         let d = dual_term(t, j, &duals.z[j]);
         let kappa = -gradient[t] / d;
         if !(kappa.is_finite() && kappa > 0.0) {
             return f64::INFINITY;
         }
-        scales[j] = kappa;
+        epigraph = Some((j, kappa));
     }
+    let scale = |j: usize| match epigraph {
+        Some((e, kappa)) if e == j => kappa,
+        _ => 1.0,
+    };
     let mut bound = value + duals.y.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
-    for (j, m) in slack_matrices.iter().enumerate() {
-        bound += scales[j] * inner(&duals.z[j], m);
+    for (j, m) in slack_matrices.enumerate() {
+        bound += scale(j) * inner(&duals.z[j], m);
     }
     for a in 0..k {
         if sdp.epigraph.is_some_and(|(t, _)| t == a) {
@@ -168,7 +173,7 @@ pub(crate) fn upper_bound(
             r -= sdp.rows[row * k + a] * y;
         }
         for j in 0..sdp.blocks.len() {
-            r += scales[j] * dual_term(a, j, &duals.z[j]);
+            r += scale(j) * dual_term(a, j, &duals.z[j]);
         }
         if r == 0.0 {
             continue;
@@ -205,8 +210,8 @@ pub(crate) fn bound_at(
         .collect();
     let inside = s.iter().all(|v| *v >= 0.0)
         && sdp.blocks.iter().zip(&matrices).all(|(b, m)| cholesky(&mut m.clone(), b.n));
-    let refs: Vec<&[f64]> = matrices.iter().map(Vec::as_slice).collect();
-    inside.then(|| upper_bound(sdp, x, value, gradient, &s, &refs, duals))
+    let refs = matrices.iter().map(Vec::as_slice);
+    inside.then(|| upper_bound(sdp, x, value, gradient, &s, refs, duals))
 }
 
 /// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the

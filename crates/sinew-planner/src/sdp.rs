@@ -18,12 +18,15 @@
 //! stays strictly feasible (every phase starts from such a point), so `s` and `S` are functions
 //! of `x`.
 
-use crate::dense::{cholesky, cholesky_inverse, cholesky_solve, inner, multiply};
+use crate::dense::{axpy, cholesky, cholesky_inverse, cholesky_solve, dot, inner};
 pub(crate) use crate::program::{Block, Duals, End, Run, Sdp, Settings, Smooth};
 use crate::program::{centred_duals, upper_bound};
 
-/// Per-block state of an iteration.
+/// Per-block state of a run: the slack, its factor and inverse, the directions, scratch, and
+/// per coefficient `F_a` the rows where it is not zero with the products `F_a Z` and `S⁻¹ F_a`
+/// of the Schur complement (module docs). Allocated once per run; nothing per iteration.
 struct BlockWork {
+    n: usize,
     s: Vec<f64>,
     l: Vec<f64>,
     s_inv: Vec<f64>,
@@ -33,13 +36,35 @@ struct BlockWork {
     ds_aff: Vec<f64>,
     t1: Vec<f64>,
     t2: Vec<f64>,
+    product: Vec<f64>,
+    correction: Vec<f64>,
     trial: Vec<f64>,
+    supports: Vec<Option<Vec<usize>>>,
+    fz: Vec<Vec<f64>>,
+    sf: Vec<Vec<f64>>,
 }
 
 impl BlockWork {
-    fn new(n: usize) -> BlockWork {
+    fn new(b: &Block) -> BlockWork {
+        let n = b.n;
         let z = || vec![0.0; n * n];
+        let supports: Vec<Option<Vec<usize>>> = b
+            .coefficients
+            .iter()
+            .map(|f| {
+                f.as_ref().map(|f| {
+                    (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
+                })
+            })
+            .collect();
+        let products = || {
+            b.coefficients
+                .iter()
+                .map(|f| if f.is_some() { z() } else { Vec::new() })
+                .collect::<Vec<_>>()
+        };
         BlockWork {
+            n,
             s: z(),
             l: z(),
             s_inv: z(),
@@ -49,25 +74,31 @@ impl BlockWork {
             ds_aff: z(),
             t1: z(),
             t2: z(),
+            product: z(),
+            correction: z(),
             trial: z(),
+            fz: products(),
+            sf: products(),
+            supports,
         }
     }
 }
 
-/// `out = sym(a b c)` (all n × n), `tmp` scratch.
+/// `out = sym(a b c)` (all n × n, `b` and `c` symmetric), `tmp` scratch.
+#[inline(always)]
 fn sym_product(a: &[f64], b: &[f64], c: &[f64], n: usize, tmp: &mut [f64], out: &mut [f64]) {
-    multiply(a, b, n, tmp);
-    multiply(tmp, c, n, out);
+    crate::dense::multiply_fast(a, b, n, tmp);
+    crate::dense::multiply_fast(tmp, c, n, out);
     crate::dense::symmetrise(out, n);
 }
 
 /// The largest `α ≤ 1` at 95 % of the way to the boundary of `v + α dv > 0` and of every
-/// `M_j + α dM_j ≻ 0` (Cholesky trials).
+/// `M_j + α dM_j ≻ 0` (Cholesky trials, each stopping at its first non-positive pivot).
+#[inline(always)]
 fn step_length(
     v: &[f64],
     dv: &[f64],
     blocks: &mut [BlockWork],
-    sizes: &[usize],
     matrices: impl Fn(&BlockWork) -> (&[f64], &[f64]),
 ) -> f64 {
     const FRACTION: f64 = 0.95;
@@ -78,13 +109,15 @@ fn step_length(
         }
     }
     for _ in 0..60 {
-        let ok = (0..blocks.len()).all(|j| {
-            let n = sizes[j];
-            let w = &mut blocks[j];
+        let ok = blocks.iter_mut().all(|w| {
+            let mut trial = std::mem::take(&mut w.trial);
             let (m, dm) = matrices(w);
-            let trial: Vec<f64> = m.iter().zip(dm).map(|(a, b)| a + alpha * b).collect();
-            w.trial.copy_from_slice(&trial);
-            cholesky(&mut w.trial, n)
+            for ((t, a), b) in trial.iter_mut().zip(m).zip(dm) {
+                *t = a + alpha * b;
+            }
+            let ok = cholesky(&mut trial, w.n);
+            w.trial = trial;
+            ok
         });
         if ok {
             return FRACTION * alpha;
@@ -94,82 +127,160 @@ fn step_length(
     0.0
 }
 
+/// The Schur complement's block terms `M_ab += tr(F_a Z F_b S⁻¹) = ⟨S⁻¹ F_b, F_a Z⟩` over the
+/// rows where `F_a` is not zero: each `A_i` is made of a few 2 × 2 joint blocks, so this
+/// costs `O(k² n)` for them. Upper triangle, mirrored (`M` is symmetric).
+#[inline(always)]
+fn add_block_schur(b: &Block, z: &[f64], w: &mut BlockWork, k: usize, schur: &mut [f64]) {
+    let n = b.n;
+    let s_inv = &w.s_inv;
+    for (a, fa) in b.coefficients.iter().enumerate() {
+        let (Some(fa), Some(rows)) = (fa, &w.supports[a]) else { continue };
+        let (fz, sf) = (&mut w.fz[a], &mut w.sf[a]);
+        if 2 * rows.len() > n {
+            // Mostly dense (a routed arm's A_i): two matrix products.
+            crate::dense::multiply_fast(fa, z, n, fz);
+            crate::dense::multiply_fast(s_inv, fa, n, sf);
+            continue;
+        }
+        for &r in rows {
+            let out = &mut fz[r * n..r * n + n];
+            out.fill(0.0);
+            for (q, v) in fa[r * n..r * n + n].iter().enumerate() {
+                if *v != 0.0 {
+                    axpy(*v, &z[q * n..q * n + n], out);
+                }
+            }
+        }
+        for (row_inv, out) in s_inv.chunks_exact(n).zip(sf.chunks_exact_mut(n)) {
+            out.fill(0.0);
+            for &q in rows {
+                axpy(row_inv[q], &fa[q * n..q * n + n], out);
+            }
+        }
+    }
+    for a in 0..k {
+        let Some(rows) = &w.supports[a] else { continue };
+        for bb in a..k {
+            if w.supports[bb].is_none() {
+                continue;
+            }
+            let (fz, sf) = (&w.fz[a], &w.sf[bb]);
+            let mut m = 0.0;
+            for &r in rows {
+                m += dot(&sf[r * n..r * n + n], &fz[r * n..r * n + n]);
+            }
+            schur[a * k + bb] += m;
+            if bb != a {
+                schur[bb * k + a] += m;
+            }
+        }
+    }
+}
+
+/// The vectors of a run (rows, variables), allocated once per run.
+struct Vectors {
+    s: Vec<f64>,
+    gradient: Vec<f64>,
+    smooth_gradient: Vec<f64>,
+    hessian: Vec<f64>,
+    schur: Vec<f64>,
+    factored: Vec<f64>,
+    dx: Vec<f64>,
+    dx_aff: Vec<f64>,
+    ds_row: Vec<f64>,
+    dy: Vec<f64>,
+    ds_aff_row: Vec<f64>,
+    dy_aff: Vec<f64>,
+}
+
+impl Vectors {
+    fn new(k: usize, p: usize) -> Vectors {
+        Vectors {
+            s: vec![0.0; p],
+            gradient: vec![0.0; k],
+            smooth_gradient: vec![0.0; k],
+            hessian: vec![0.0; k * k],
+            schur: vec![0.0; k * k],
+            factored: vec![0.0; k * k],
+            dx: vec![0.0; k],
+            dx_aff: vec![0.0; k],
+            ds_row: vec![0.0; p],
+            dy: vec![0.0; p],
+            ds_aff_row: vec![0.0; p],
+            dy_aff: vec![0.0; p],
+        }
+    }
+}
+
 /// Run the method from the strictly feasible `x0`, with multipliers centred there.
+///
+/// The whole run is compiled once per instruction set and dispatched at run time by pulp
+/// (AVX2 and FMA where the processor has them): its kernels are small dense loops over rows
+/// of 5–20 entries, which the wider vectors serve. The arithmetic is the same on every path
+/// up to the rounding of fused multiply–adds.
 pub(crate) fn solve(
     sdp: &Sdp,
-    mut smooth: Option<&mut dyn Smooth>,
+    smooth: Option<&mut dyn Smooth>,
+    x0: &[f64],
+    settings: Settings,
+) -> Run {
+    pulp::Arch::new().dispatch(Solve { sdp, smooth, x0, settings })
+}
+
+/// The arguments of [`solve`] as a pulp operation.
+struct Solve<'a, 'b> {
+    sdp: &'a Sdp,
+    smooth: Option<&'a mut (dyn Smooth + 'b)>,
+    x0: &'a [f64],
+    settings: Settings,
+}
+
+impl pulp::WithSimd for Solve<'_, '_> {
+    type Output = Run;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Run {
+        solve_body(self.sdp, self.smooth, self.x0, self.settings)
+    }
+}
+
+#[inline(always)]
+fn solve_body<'s>(
+    sdp: &Sdp,
+    mut smooth: Option<&mut (dyn Smooth + 's)>,
     x0: &[f64],
     settings: Settings,
 ) -> Run {
     let k = sdp.vars();
     let p = sdp.row_count();
-    let sizes: Vec<usize> = sdp.blocks.iter().map(|b| b.n).collect();
-    let nu = (p + sizes.iter().sum::<usize>()) as f64;
-    let mut works: Vec<BlockWork> = sizes.iter().map(|&n| BlockWork::new(n)).collect();
+    let nu = (p + sdp.blocks.iter().map(|b| b.n).sum::<usize>()) as f64;
+    let mut works: Vec<BlockWork> = sdp.blocks.iter().map(BlockWork::new).collect();
+    let mut v = Vectors::new(k, p);
     let mut x = x0.to_vec();
-    let mut s = vec![0.0; p];
-    let mut gradient = vec![0.0; k];
-    let mut hessian = vec![0.0; k * k];
-    let mut schur = vec![0.0; k * k];
-    let mut column = vec![0.0; sizes.iter().copied().max().unwrap_or(0).max(k)];
-    let (mut dx, mut dx_aff) = (vec![0.0; k], vec![0.0; k]);
-    let (mut ds_row, mut dy, mut ds_aff_row, mut dy_aff) =
-        (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
     let mut duals = Duals::default();
-    // The rows where each coefficient is not zero, and per coefficient `F_a Z` and `S⁻¹ F_a`.
-    let supports: Vec<Vec<Option<Vec<usize>>>> = sdp
-        .blocks
-        .iter()
-        .map(|b| {
-            let n = b.n;
-            b.coefficients
-                .iter()
-                .map(|f| {
-                    f.as_ref().map(|f| {
-                        (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
-                    })
-                })
-                .collect()
-        })
-        .collect();
-    let mut products: Vec<Vec<(Vec<f64>, Vec<f64>)>> = sdp
-        .blocks
-        .iter()
-        .map(|b| {
-            b.coefficients
-                .iter()
-                .map(|f| match f {
-                    Some(_) => (vec![0.0; b.n * b.n], vec![0.0; b.n * b.n]),
-                    None => (Vec::new(), Vec::new()),
-                })
-                .collect()
-        })
-        .collect();
     let mut best: Option<(f64, f64)> = None;
     let run = |x: Vec<f64>, value, upper, iterations, end| Run { x, value, upper, iterations, end };
     for iteration in 0..=settings.max_iterations {
         // The slacks, their factors and inverses, the objective.
-        sdp.slacks(&x, &mut s);
-        let mut interior = s.iter().all(|v| *v > 0.0);
+        sdp.slacks(&x, &mut v.s);
+        let mut interior = v.s.iter().all(|s| *s > 0.0);
         for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
             b.at(&x, &mut w.s);
             w.l.copy_from_slice(&w.s);
             interior &= cholesky(&mut w.l, b.n);
             if interior {
-                cholesky_inverse(&w.l, b.n, &mut w.s_inv, &mut column);
+                cholesky_inverse(&w.l, b.n, &mut w.s_inv, &mut w.t1);
             }
         }
-        gradient.copy_from_slice(&sdp.c);
-        hessian.fill(0.0);
-        let mut value = sdp.c0 + sdp.c.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>();
+        v.gradient.copy_from_slice(&sdp.c);
+        v.hessian.fill(0.0);
+        let mut value = sdp.c0 + dot(&sdp.c, &x);
         if let Some(smooth) = smooth.as_deref_mut() {
-            let mut g = vec![0.0; k];
-            match smooth.evaluate(&x, &mut g, &mut hessian) {
-                Some(v) => {
-                    value += v;
-                    for (a, b) in gradient.iter_mut().zip(&g) {
-                        *a += b;
-                    }
+            match smooth.evaluate(&x, &mut v.smooth_gradient, &mut v.hessian) {
+                Some(psi) => {
+                    value += psi;
+                    axpy(1.0, &v.smooth_gradient, &mut v.gradient);
                 }
                 None => interior = false,
             }
@@ -180,13 +291,16 @@ pub(crate) fn solve(
         }
         if iteration == 0 {
             let inverses: Vec<&[f64]> = works.iter().map(|w| w.s_inv.as_slice()).collect();
-            duals = centred_duals(sdp, &gradient, &s, &inverses, value, settings.scale);
+            duals = centred_duals(sdp, &v.gradient, &v.s, &inverses, value, settings.scale);
         }
-        let mu = (duals.y.iter().zip(&s).map(|(a, b)| a * b).sum::<f64>()
+        let s = &v.s;
+        let mu = (dot(&duals.y, s)
             + works.iter().zip(&duals.z).map(|(w, z)| inner(z, &w.s)).sum::<f64>())
             / nu.max(1.0);
-        let matrices: Vec<&[f64]> = works.iter().map(|w| w.s.as_slice()).collect();
-        let upper = upper_bound(sdp, &x, value, &gradient, &s, &matrices, &duals);
+        let upper = {
+            let matrices = works.iter().map(|w| w.s.as_slice());
+            upper_bound(sdp, &x, value, &v.gradient, s, matrices, &duals)
+        };
         best = Some((value, upper));
         if let Some(target) = settings.target {
             let converged =
@@ -207,101 +321,53 @@ pub(crate) fn solve(
             return run(x, value, upper, iteration, End::NotConverged);
         }
         // The Schur complement.
-        for (e, h) in schur.iter_mut().zip(&hessian) {
+        for (e, h) in v.schur.iter_mut().zip(&v.hessian) {
             *e = -h;
         }
         for r in 0..p {
             let g = &sdp.rows[r * k..r * k + k];
             let d = duals.y[r] / s[r];
             for a in 0..k {
-                if g[a] == 0.0 {
-                    continue;
-                }
-                for b in 0..k {
-                    schur[a * k + b] += d * g[a] * g[b];
+                if g[a] != 0.0 {
+                    axpy(d * g[a], g, &mut v.schur[a * k..a * k + k]);
                 }
             }
         }
-        // M_ab = tr(F_a Z F_b S⁻¹) = ⟨S⁻¹ F_b, F_a Z⟩ over the rows where F_a is not zero:
-        // each A_i is made of a few 2 × 2 joint blocks, so this costs O(k² n) for them.
-        for (j, b) in sdp.blocks.iter().enumerate() {
-            let n = b.n;
-            let (z, s_inv) = (&duals.z[j], &works[j].s_inv);
-            for (a, fa) in b.coefficients.iter().enumerate() {
-                let (Some(fa), Some(rows)) = (fa, &supports[j][a]) else { continue };
-                let (fz, sf) = &mut products[j][a];
-                fz.fill(0.0);
-                sf.fill(0.0);
-                for &r in rows {
-                    for q in 0..n {
-                        let v = fa[r * n + q];
-                        if v != 0.0 {
-                            for c in 0..n {
-                                fz[r * n + c] += v * z[q * n + c];
-                            }
-                        }
-                    }
-                }
-                for r in 0..n {
-                    for &q in rows {
-                        let v = s_inv[r * n + q];
-                        for c in 0..n {
-                            sf[r * n + c] += v * fa[q * n + c];
-                        }
-                    }
-                }
-            }
-            for a in 0..k {
-                let Some(rows) = &supports[j][a] else { continue };
-                for bb in 0..k {
-                    if supports[j][bb].is_none() {
-                        continue;
-                    }
-                    let (fz, sf) = (&products[j][a].0, &products[j][bb].1);
-                    let mut m = 0.0;
-                    for &r in rows {
-                        m += inner(&sf[r * n..r * n + n], &fz[r * n..r * n + n]);
-                    }
-                    schur[a * k + bb] += m;
-                }
-            }
+        for ((b, w), z) in sdp.blocks.iter().zip(works.iter_mut()).zip(&duals.z) {
+            add_block_schur(b, z, w, k, &mut v.schur);
         }
-        crate::dense::symmetrise(&mut schur, k);
-        let trace: f64 = (0..k).map(|a| schur[a * k + a].abs()).sum::<f64>().max(1e-300);
-        let mut factored = schur.clone();
-        if !cholesky(&mut factored, k) {
-            factored.copy_from_slice(&schur);
+        crate::dense::symmetrise(&mut v.schur, k);
+        let trace: f64 = (0..k).map(|a| v.schur[a * k + a].abs()).sum::<f64>().max(1e-300);
+        v.factored.copy_from_slice(&v.schur);
+        if !cholesky(&mut v.factored, k) {
+            v.factored.copy_from_slice(&v.schur);
             for a in 0..k {
-                factored[a * k + a] += 1e-12 * trace;
+                v.factored[a * k + a] += 1e-12 * trace;
             }
-            if !cholesky(&mut factored, k) {
+            if !cholesky(&mut v.factored, k) {
                 return run(x, value, upper, iteration, End::Breakdown);
             }
         }
         // Predictor (σ = 0).
-        dx_aff.copy_from_slice(&gradient);
-        cholesky_solve(&factored, k, &mut dx_aff);
-        directions(sdp, &s, &duals, &dx_aff, 0.0, &mut ds_aff_row, &mut dy_aff);
-        for (j, b) in sdp.blocks.iter().enumerate() {
-            let w = &mut works[j];
-            matrix_step(b, &dx_aff, &mut w.ds_aff);
-            let (ds, z, s_inv, n) = (&w.ds_aff, &duals.z[j], &w.s_inv, b.n);
+        v.dx_aff.copy_from_slice(&v.gradient);
+        cholesky_solve(&v.factored, k, &mut v.dx_aff);
+        directions(sdp, s, &duals, &v.dx_aff, 0.0, &mut v.ds_aff_row, &mut v.dy_aff);
+        for ((b, w), z) in sdp.blocks.iter().zip(works.iter_mut()).zip(&duals.z) {
+            matrix_step(b, &v.dx_aff, &mut w.ds_aff);
             // ΔZ = −Z − sym(Z ΔS S⁻¹).
-            let mut out = vec![0.0; n * n];
-            sym_product(z, ds, s_inv, n, &mut w.t1, &mut out);
-            for ((d, zz), o) in w.dz_aff.iter_mut().zip(z).zip(&out) {
+            sym_product(z, &w.ds_aff, &w.s_inv, b.n, &mut w.t1, &mut w.product);
+            for ((d, zz), o) in w.dz_aff.iter_mut().zip(z).zip(&w.product) {
                 *d = -zz - o;
             }
         }
-        let alpha_p = step_length(&s, &ds_aff_row, &mut works, &sizes, |w| (&w.s, &w.ds_aff));
+        let alpha_p = step_length(s, &v.ds_aff_row, &mut works, |w| (&w.s, &w.ds_aff));
         zs(&mut works, &duals);
-        let alpha_d = step_length(&duals.y, &dy_aff, &mut works, &sizes, |w| (&w.t2, &w.dz_aff));
+        let alpha_d = step_length(&duals.y, &v.dy_aff, &mut works, |w| (&w.t2, &w.dz_aff));
         let mut mu_aff = 0.0;
         for r in 0..p {
-            mu_aff += (s[r] + alpha_p * ds_aff_row[r]) * (duals.y[r] + alpha_d * dy_aff[r]);
+            mu_aff += (s[r] + alpha_p * v.ds_aff_row[r]) * (duals.y[r] + alpha_d * v.dy_aff[r]);
         }
-        for (j, w) in works.iter().enumerate() {
-            let z = &duals.z[j];
+        for (w, z) in works.iter().zip(&duals.z) {
             for e in 0..w.s.len() {
                 mu_aff += (w.s[e] + alpha_p * w.ds_aff[e]) * (z[e] + alpha_d * w.dz_aff[e]);
             }
@@ -310,64 +376,50 @@ pub(crate) fn solve(
         let sigma = (mu_aff / mu).clamp(0.0, 1.0).powi(3);
         let sigma_mu = sigma * mu;
         // Corrector: the right-hand side with the second-order terms.
-        dx.copy_from_slice(&gradient);
+        v.dx.copy_from_slice(&v.gradient);
         for r in 0..p {
-            let coefficient = (sigma_mu - ds_aff_row[r] * dy_aff[r]) / s[r];
-            for a in 0..k {
-                dx[a] -= sdp.rows[r * k + a] * coefficient;
-            }
+            let coefficient = (sigma_mu - v.ds_aff_row[r] * v.dy_aff[r]) / s[r];
+            axpy(-coefficient, &sdp.rows[r * k..r * k + k], &mut v.dx);
         }
-        let mut corrections: Vec<Vec<f64>> = Vec::with_capacity(works.len());
-        for (j, b) in sdp.blocks.iter().enumerate() {
-            let n = b.n;
-            let w = &mut works[j];
+        for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
             // W = σμ S⁻¹ − sym(ΔZ_aff ΔS_aff S⁻¹).
-            let mut second = vec![0.0; n * n];
-            sym_product(&w.dz_aff, &w.ds_aff, &w.s_inv, n, &mut w.t1, &mut second);
-            let correction: Vec<f64> =
-                w.s_inv.iter().zip(&second).map(|(si, c)| sigma_mu * si - c).collect();
-            for a in 0..k {
-                if let Some(fa) = &b.coefficients[a] {
-                    dx[a] += inner(fa, &correction);
+            sym_product(&w.dz_aff, &w.ds_aff, &w.s_inv, b.n, &mut w.t1, &mut w.product);
+            for ((c, si), o) in w.correction.iter_mut().zip(&w.s_inv).zip(&w.product) {
+                *c = sigma_mu * si - o;
+            }
+            for (a, fa) in b.coefficients.iter().enumerate() {
+                if let Some(fa) = fa {
+                    v.dx[a] += inner(fa, &w.correction);
                 }
             }
-            corrections.push(correction);
         }
-        cholesky_solve(&factored, k, &mut dx);
-        directions(sdp, &s, &duals, &dx, sigma_mu, &mut ds_row, &mut dy);
+        cholesky_solve(&v.factored, k, &mut v.dx);
+        directions(sdp, s, &duals, &v.dx, sigma_mu, &mut v.ds_row, &mut v.dy);
         for r in 0..p {
-            dy[r] -= ds_aff_row[r] * dy_aff[r] / s[r];
+            v.dy[r] -= v.ds_aff_row[r] * v.dy_aff[r] / s[r];
         }
-        for (j, b) in sdp.blocks.iter().enumerate() {
-            let w = &mut works[j];
-            matrix_step(b, &dx, &mut w.ds);
-            let n = b.n;
-            let mut out = vec![0.0; n * n];
-            sym_product(&duals.z[j], &w.ds, &w.s_inv, n, &mut w.t1, &mut out);
-            for e in 0..n * n {
-                w.dz[e] = corrections[j][e] - duals.z[j][e] - out[e];
+        for ((b, w), z) in sdp.blocks.iter().zip(works.iter_mut()).zip(&duals.z) {
+            matrix_step(b, &v.dx, &mut w.ds);
+            sym_product(z, &w.ds, &w.s_inv, b.n, &mut w.t1, &mut w.product);
+            for e in 0..w.dz.len() {
+                w.dz[e] = w.correction[e] - z[e] - w.product[e];
             }
         }
-        let alpha_p = step_length(&s, &ds_row, &mut works, &sizes, |w| (&w.s, &w.ds));
+        let alpha_p = step_length(s, &v.ds_row, &mut works, |w| (&w.s, &w.ds));
         zs(&mut works, &duals);
-        let alpha_d = step_length(&duals.y, &dy, &mut works, &sizes, |w| (&w.t2, &w.dz));
-        for (xa, d) in x.iter_mut().zip(&dx) {
-            *xa += alpha_p * d;
-        }
-        for (ya, d) in duals.y.iter_mut().zip(&dy) {
-            *ya += alpha_d * d;
-        }
+        let alpha_d = step_length(&duals.y, &v.dy, &mut works, |w| (&w.t2, &w.dz));
+        axpy(alpha_p, &v.dx, &mut x);
+        axpy(alpha_d, &v.dy, &mut duals.y);
         for (z, w) in duals.z.iter_mut().zip(&works) {
-            for (ze, d) in z.iter_mut().zip(&w.dz) {
-                *ze += alpha_d * d;
-            }
-            crate::dense::symmetrise(z, w.s.len().isqrt());
+            axpy(alpha_d, &w.dz, z);
+            crate::dense::symmetrise(z, w.n);
         }
     }
     unreachable!("the loop returns at its last iteration")
 }
 
 /// Copy each block's `Z` into its `t2` (for the dual step-length trials).
+#[inline(always)]
 fn zs(works: &mut [BlockWork], duals: &Duals) {
     for (w, z) in works.iter_mut().zip(&duals.z) {
         w.t2.copy_from_slice(z);
@@ -375,18 +427,18 @@ fn zs(works: &mut [BlockWork], duals: &Duals) {
 }
 
 /// `ΔF = Σ_a dx_a F_a` into `out`.
+#[inline(always)]
 fn matrix_step(b: &Block, dx: &[f64], out: &mut [f64]) {
     out.fill(0.0);
     for (d, fa) in dx.iter().zip(&b.coefficients) {
         if let Some(fa) = fa {
-            for (o, f) in out.iter_mut().zip(fa) {
-                *o += d * f;
-            }
+            axpy(*d, fa, out);
         }
     }
 }
 
 /// The row parts of a direction: `Δs = −G Δx`, `Δy = σμ/s − y − (y/s)∘Δs`.
+#[inline(always)]
 fn directions(
     sdp: &Sdp,
     s: &[f64],
@@ -399,7 +451,7 @@ fn directions(
     let k = sdp.vars();
     for r in 0..s.len() {
         let g = &sdp.rows[r * k..r * k + k];
-        ds[r] = -g.iter().zip(dx).map(|(a, b)| a * b).sum::<f64>();
+        ds[r] = -dot(g, dx);
         dy[r] = sigma_mu / s[r] - duals.y[r] - duals.y[r] / s[r] * ds[r];
     }
 }

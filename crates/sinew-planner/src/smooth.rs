@@ -15,7 +15,7 @@
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use sinew_stiffness::compliance_inverse;
 
-use crate::dense::{cholesky, cholesky_solve};
+use crate::dense::{axpy, cholesky, cholesky_solve, dot};
 use crate::frame::Frame;
 use crate::sdp::Smooth;
 
@@ -28,14 +28,27 @@ pub(crate) enum Kind {
     Volume,
 }
 
-/// A smooth objective on a frame, divided by `scale`.
+/// A smooth objective on a frame, divided by `scale`, with the buffers of its evaluations
+/// (allocated once: an evaluation allocates nothing). Vectors of length n are stored one after
+/// another (`Yᵀ` as 6 rows, `z_j`, `A_a z_j`, `P A_a z_j`), so that every product is a dot
+/// product or an update of contiguous slices.
 pub(crate) struct EndObjective<'a> {
     pub(crate) frame: &'a Frame,
     pub(crate) kind: Kind,
     pub(crate) scale: f64,
+    /// The Cholesky factor of `A(x)`.
     a: Vec<f64>,
-    y: Vec<f64>,
-    column: Vec<f64>,
+    /// `Yᵀ = J_x A⁻¹` (6 × n).
+    yt: Vec<f64>,
+    /// The rows of each `A_a` that are not zero.
+    supports: Vec<Vec<usize>>,
+    /// `z_j` (c × n).
+    zs: Vec<f64>,
+    /// `A_a z_j` and `P A_a z_j` (k × c × n).
+    az: Vec<f64>,
+    pa: Vec<f64>,
+    /// `G_a = zsᵀ A_a zs` (k × c × c).
+    g: Vec<f64>,
 }
 
 /// `K_x` at `x` (the factor of `A` and `Y = A⁻¹ J_xᵀ` stay in the objective's buffers).
@@ -45,14 +58,23 @@ pub(crate) struct EndAt {
 
 impl<'a> EndObjective<'a> {
     pub(crate) fn new(frame: &'a Frame, kind: Kind, scale: f64) -> EndObjective<'a> {
-        let n = frame.n;
+        let (n, k) = (frame.n, frame.vars());
+        let supports = frame
+            .ai
+            .iter()
+            .map(|a| (0..n).filter(|r| a[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect())
+            .collect();
         EndObjective {
             frame,
             kind,
             scale,
             a: vec![0.0; n * n],
-            y: vec![0.0; n * 6],
-            column: vec![0.0; n],
+            yt: vec![0.0; 6 * n],
+            supports,
+            zs: vec![0.0; 3 * n],
+            az: vec![0.0; k * 3 * n],
+            pa: vec![0.0; k * 3 * n],
+            g: vec![0.0; k * 9],
         }
     }
 
@@ -64,77 +86,47 @@ impl<'a> EndObjective<'a> {
         if !cholesky(&mut self.a, n) {
             return None;
         }
-        for j in 0..6 {
-            self.column.copy_from_slice(&self.frame.j_x[j * n..j * n + n]);
-            cholesky_solve(&self.a, n, &mut self.column);
-            for d in 0..n {
-                self.y[d * 6 + j] = self.column[d];
-            }
-        }
         let j_x = &self.frame.j_x;
-        let c_x = Matrix6::from_fn(|r, c| (0..n).map(|d| j_x[r * n + d] * self.y[d * 6 + c]).sum());
+        self.yt.copy_from_slice(&j_x[..6 * n]);
+        for row in self.yt.chunks_exact_mut(n) {
+            cholesky_solve(&self.a, n, row);
+        }
+        let c_x = Matrix6::from_fn(|r, c| dot(&j_x[r * n..r * n + n], &self.yt[c * n..c * n + n]));
         let c_x = 0.5 * (c_x + c_x.transpose());
         let k_x = compliance_inverse(&c_x).ok()?;
         Some(EndAt { k_x: 0.5 * (k_x + k_x.transpose()) })
     }
 
-    /// `P v` for the factor in `self.a` (after [`Self::end_at`]).
-    fn p_times(&self, k_x: &Matrix6<f64>, v: &[f64], out: &mut [f64]) {
-        let n = self.frame.n;
+    /// `P v` into `out` for the factor in `self.a` (after [`Self::end_at`]):
+    /// `A⁻¹ v − Y K_x Yᵀ v`.
+    fn p_times(a: &[f64], yt: &[f64], k_x: &Matrix6<f64>, v: &[f64], out: &mut [f64]) {
+        let n = v.len();
         out.copy_from_slice(v);
-        cholesky_solve(&self.a, n, out);
-        let ytv = Vector6::from_fn(|j, _| (0..n).map(|d| self.y[d * 6 + j] * v[d]).sum());
+        cholesky_solve(a, n, out);
+        let ytv = Vector6::from_fn(|j, _| dot(&yt[j * n..j * n + n], v));
         let kv = k_x * ytv;
-        for (d, o) in out.iter_mut().enumerate() {
-            *o -= (0..6).map(|j| self.y[d * 6 + j] * kv[j]).sum::<f64>();
+        for (j, row) in yt.chunks_exact(n).enumerate() {
+            axpy(-kv[j], row, out);
         }
     }
 
-    /// `Y K_x M` for a 6 × c matrix `M` given by columns: n × c row-major.
-    fn v_times(&self, k_x: &Matrix6<f64>, columns: &[Vector6<f64>]) -> Vec<f64> {
+    /// `z_j = Y K_x m_j` for the 6-vectors `columns` into `self.zs`.
+    fn v_times(&mut self, k_x: &Matrix6<f64>, columns: &[Vector6<f64>]) {
         let n = self.frame.n;
-        let c = columns.len();
-        let mut out = vec![0.0; n * c];
-        for (j, m) in columns.iter().enumerate() {
+        for (m, z) in columns.iter().zip(self.zs.chunks_exact_mut(n)) {
             let km = k_x * m;
-            for d in 0..n {
-                out[d * c + j] = (0..6).map(|i| self.y[d * 6 + i] * km[i]).sum();
+            z.fill(0.0);
+            for (i, row) in self.yt.chunks_exact(n).enumerate() {
+                axpy(km[i], row, z);
             }
         }
-        out
     }
 
-    /// `A_a z` for every free coordinate, each z a column of the n × c matrix `zs`: per
-    /// coordinate n × c row-major.
-    fn pencil_times(&self, zs: &[f64], c: usize) -> Vec<Vec<f64>> {
-        let n = self.frame.n;
-        self.frame
-            .ai
-            .iter()
-            .map(|a| {
-                let mut out = vec![0.0; n * c];
-                for r in 0..n {
-                    for p in 0..n {
-                        let v = a[r * n + p];
-                        if v == 0.0 {
-                            continue;
-                        }
-                        for j in 0..c {
-                            out[r * c + j] += v * zs[p * c + j];
-                        }
-                    }
-                }
-                out
-            })
-            .collect()
-    }
-
-    /// The value, gradient and Hessian (unscaled) with `zs` the n × c matrix of the method
-    /// (`z` or `U`) and the 3 × 3 `G_a` terms when `volume`.
+    /// The gradient and Hessian (unscaled) of the form with the `c` vectors `z_j` in
+    /// `self.zs`, the 3 × 3 `G_a` terms when `volume`.
     fn forms(
-        &self,
+        &mut self,
         k_x: &Matrix6<f64>,
-        zs: &[f64],
         c: usize,
         volume: bool,
         gradient: &mut [f64],
@@ -142,51 +134,48 @@ impl<'a> EndObjective<'a> {
     ) {
         let n = self.frame.n;
         let k = self.frame.vars();
-        let az = self.pencil_times(zs, c);
-        // G_a = zsᵀ A_a zs (c × c); gradient = tr G_a.
-        let g: Vec<Vec<f64>> = az
-            .iter()
-            .map(|a| {
-                let mut m = vec![0.0; c * c];
-                for i in 0..c {
-                    for j in 0..c {
-                        m[i * c + j] = (0..n).map(|d| zs[d * c + i] * a[d * c + j]).sum();
-                    }
+        let zs = &self.zs[..c * n];
+        // A_a z_j over the rows where A_a is not zero (A_a symmetric: rows against z).
+        for (a, (ai, rows)) in self.frame.ai.iter().zip(&self.supports).enumerate() {
+            for (j, z) in zs.chunks_exact(n).enumerate() {
+                let out = &mut self.az[(a * c + j) * n..(a * c + j + 1) * n];
+                out.fill(0.0);
+                for &r in rows {
+                    out[r] = dot(&ai[r * n..r * n + n], z);
                 }
-                m
-            })
-            .collect();
-        for a in 0..k {
-            gradient[a] = (0..c).map(|i| g[a][i * c + i]).sum();
-        }
-        // P A_b z, column by column.
-        let mut column = vec![0.0; n];
-        let mut p_out = vec![0.0; n];
-        let pa: Vec<Vec<f64>> = az
-            .iter()
-            .map(|a| {
-                let mut out = vec![0.0; n * c];
-                for j in 0..c {
-                    for d in 0..n {
-                        column[d] = a[d * c + j];
-                    }
-                    self.p_times(k_x, &column, &mut p_out);
-                    for d in 0..n {
-                        out[d * c + j] = p_out[d];
-                    }
-                }
-                out
-            })
-            .collect();
-        for a in 0..k {
-            for b in 0..k {
-                let cross: f64 = az[a].iter().zip(&pa[b]).map(|(x, y)| x * y).sum();
-                let gg: f64 =
-                    if volume { g[a].iter().zip(&g[b]).map(|(x, y)| x * y).sum() } else { 0.0 };
-                hessian[a * k + b] = -2.0 * cross - gg;
             }
         }
-        crate::dense::symmetrise(hessian, k);
+        // G_a = zsᵀ A_a zs (c × c); gradient = tr G_a.
+        for a in 0..k {
+            let mut trace = 0.0;
+            for i in 0..c {
+                for j in 0..c {
+                    let v = dot(&zs[i * n..i * n + n], &self.az[(a * c + j) * n..][..n]);
+                    self.g[a * c * c + i * c + j] = v;
+                    if i == j {
+                        trace += v;
+                    }
+                }
+            }
+            gradient[a] = trace;
+        }
+        // P A_b z_j.
+        for (az, pa) in self.az[..k * c * n].chunks_exact(n).zip(self.pa.chunks_exact_mut(n)) {
+            Self::p_times(&self.a, &self.yt, k_x, az, pa);
+        }
+        for a in 0..k {
+            for b in a..k {
+                let cross =
+                    dot(&self.az[a * c * n..(a + 1) * c * n], &self.pa[b * c * n..(b + 1) * c * n]);
+                let gg = if volume {
+                    dot(&self.g[a * c * c..(a + 1) * c * c], &self.g[b * c * c..(b + 1) * c * c])
+                } else {
+                    0.0
+                };
+                hessian[a * k + b] = -2.0 * cross - gg;
+                hessian[b * k + a] = -2.0 * cross - gg;
+            }
+        }
     }
 }
 
@@ -196,8 +185,8 @@ impl Smooth for EndObjective<'_> {
         let k_x = end.k_x;
         let value = match self.kind {
             Kind::Along(w) => {
-                let z = self.v_times(&k_x, &[w]);
-                self.forms(&k_x, &z, 1, false, gradient, hessian);
+                self.v_times(&k_x, &[w]);
+                self.forms(&k_x, 1, false, gradient, hessian);
                 w.dot(&(k_x * w))
             }
             Kind::Volume => {
@@ -205,11 +194,11 @@ impl Smooth for EndObjective<'_> {
                 let l = k_fd.cholesky()?.l();
                 let l_inv_t = l.try_inverse()?.transpose();
                 // U = Y K_x [I₃; 0] L⁻ᵀ.
-                let columns: Vec<Vector6<f64>> = (0..3)
-                    .map(|a| Vector6::from_fn(|r, _| if r < 3 { l_inv_t[(r, a)] } else { 0.0 }))
-                    .collect();
-                let u = self.v_times(&k_x, &columns);
-                self.forms(&k_x, &u, 3, true, gradient, hessian);
+                let columns: [Vector6<f64>; 3] = std::array::from_fn(|a| {
+                    Vector6::from_fn(|r, _| if r < 3 { l_inv_t[(r, a)] } else { 0.0 })
+                });
+                self.v_times(&k_x, &columns);
+                self.forms(&k_x, 3, true, gradient, hessian);
                 2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>()
             }
         };
