@@ -4,13 +4,15 @@
 //!
 //! `cargo run --release -p sinew-planner --example plan_profile -- MODEL OBJECTIVE N METHOD`
 //! with MODEL `decoupled` or `routed`, OBJECTIVE one of `stiffness-along`, `compliance-along`,
-//! `min-stiffness`, `volume`, `least-tension`, and METHOD `ipm` or `bundle`.
+//! `min-stiffness`, `volume`, `least-tension`, and METHOD `ipm` or `bundle`; with METHOD
+//! `along`, N times the bench's 100-step 1 kHz trajectory, warm-started (instructions per step:
+//! the difference divided by 100 N).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::hint::black_box;
 
 use nalgebra::{Vector3, Vector6};
-use sinew_planner::{Method, Objective, PlanSettings, Planner, PlannerData, Requirements};
+use sinew_planner::{Method, Objective, PlanSettings, Planner, PlannerData, Requirements, Step};
 use sinew_routing::PatternModel;
 use sinew_stiffness::ArmStiffness;
 use sinew_testkit::cdhrm5;
@@ -39,6 +41,30 @@ fn main() {
     let q = cdhrm5::LOADED_POSE;
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let requirements = Requirements::default();
+    if args.get(4).map(String::as_str) == Some("along") {
+        // The bench's trajectory: joints at up to 3 rad/s about the loaded pose, 1 kHz.
+        let steps: Vec<Step> = (0..100)
+            .map(|k| Step {
+                q: (0..10)
+                    .map(|j| {
+                        let omega = 0.5 + 14.5 * j as f64 / 9.0;
+                        q[j] + 0.2 * (omega * k as f64 * 1e-3).sin()
+                    })
+                    .collect(),
+                f0,
+            })
+            .collect();
+        let settings = PlanSettings::default();
+        let mut warm = 0;
+        for _ in 0..plans {
+            let along = planner
+                .plan_along(&mut data, black_box(&steps), objective, &requirements, &settings, None)
+                .unwrap();
+            warm = along.iter().filter(|s| s.warm).count();
+        }
+        println!("{warm} of 100 steps warm");
+        return;
+    }
     let settings = PlanSettings { method, ..PlanSettings::default() };
     let mut last = None;
     for _ in 0..plans {

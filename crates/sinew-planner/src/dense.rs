@@ -163,23 +163,12 @@ fn cholesky_solve_dynamic(l: &[f64], n: usize, b: &mut [f64]) {
 }
 
 /// `out = (L Lᵀ)⁻¹ = L⁻ᵀ L⁻¹`, full and symmetric (`l` from [`cholesky`]): `T = L⁻¹` row by
-/// row (`T_i = (e_i − Σ_{p<i} L_ip T_p) / L_ii`) into the scratch `t` (n × n), then `Tᵀ T` by
-/// a matrix product.
+/// row (`T_i = (e_i − Σ_{p<i} L_ip T_p) / L_ii`) into the scratch `t` (n × n), then `Tᵀ T`
+/// as a sum of outer products of its rows.
 #[inline(always)]
 pub(crate) fn cholesky_inverse(l: &[f64], n: usize, out: &mut [f64], t: &mut [f64]) {
     fixed_size!(n, lower_inverse_fixed(l, t), lower_inverse_dynamic(l, n, t));
-    let t = faer::MatRef::from_row_major_slice(&t[..n * n], n, n);
-    {
-        let out = faer::MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
-        faer::linalg::matmul::matmul(
-            out,
-            faer::Accum::Replace,
-            t.transpose(),
-            t,
-            1.0,
-            faer::Par::Seq,
-        );
-    }
+    gram_of_rows(t, n, out);
     symmetrise(out, n);
 }
 
@@ -233,13 +222,49 @@ pub(crate) fn symmetrise(a: &mut [f64], n: usize) {
     }
 }
 
-/// `out = a b` (all n × n, row-major): faer's matrix product, whose small-size kernels
-/// (nano-gemm, dispatched per instruction set) serve these 5–20-row blocks.
+/// `out = a b` (all n × n, row-major): fixed-size kernels up to n = 17 (each output row an
+/// accumulation of whole rows of `b`, which the compiler unrolls and vectorises), faer's
+/// product above.
+#[inline(always)]
 pub(crate) fn multiply_fast(a: &[f64], b: &[f64], n: usize, out: &mut [f64]) {
+    fixed_size!(n, multiply_fixed(a, b, out), multiply_faer(a, b, n, out))
+}
+
+#[inline(always)]
+fn multiply_fixed<const N: usize>(a: &[f64], b: &[f64], out: &mut [f64]) {
+    let (a, _) = a[..N * N].as_chunks::<N>();
+    let (b, _) = b[..N * N].as_chunks::<N>();
+    let (out, _) = out[..N * N].as_chunks_mut::<N>();
+    for (row_a, row_out) in a.iter().zip(out.iter_mut()) {
+        let mut acc = [0.0; N];
+        for (v, row_b) in row_a.iter().zip(b) {
+            for c in 0..N {
+                acc[c] += v * row_b[c];
+            }
+        }
+        *row_out = acc;
+    }
+}
+
+fn multiply_faer(a: &[f64], b: &[f64], n: usize, out: &mut [f64]) {
     let a = faer::MatRef::from_row_major_slice(&a[..n * n], n, n);
     let b = faer::MatRef::from_row_major_slice(&b[..n * n], n, n);
     let out = faer::MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
     faer::linalg::matmul::matmul(out, faer::Accum::Replace, a, b, 1.0, faer::Par::Seq);
+}
+
+/// `out = Tᵀ T` (all n × n, row-major; `T` lower triangular): `Σ_p T_p ⊗ T_p` over the rows
+/// of `T`, each row's non-zero head only.
+#[inline(always)]
+fn gram_of_rows(t: &[f64], n: usize, out: &mut [f64]) {
+    let out = &mut out[..n * n];
+    out.fill(0.0);
+    for p in 0..n {
+        let row = &t[p * n..p * n + p + 1];
+        for (r, v) in row.iter().enumerate() {
+            axpy(*v, row, &mut out[r * n..r * n + p + 1]);
+        }
+    }
 }
 
 /// `out = a b` (all n × n).

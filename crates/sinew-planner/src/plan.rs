@@ -110,14 +110,13 @@ impl Planner {
         let fixed = self.fixed_tensions(sd, requirements)?;
         let (set, least_total) = match settings.method {
             // The equilibrium set and one tension stage (the pencil needs the stage's inherent
-            // stiffness); infeasibility shows in the first phase.
-            // (Any balancing tensions within the limits do: the paper's levels at one half
-            // when the closed form holds them, else the least-total policy.)
+            // stiffness, which does not depend on the tensions); infeasibility shows in the
+            // first phase. Any balancing tensions within the limits do: the closed form's
+            // lowest levels when it holds them (no program), else the least-total policy.
             Method::InteriorPoint => {
                 let set = arm.equilibrium_set(sd)?.clone();
-                let half = vec![0.5; joints];
                 let by_levels = arm.statics().has_levels()
-                    && arm.set_tensions(sd, TensionChoice::Levels(&half)).is_ok();
+                    && arm.set_tensions(sd, TensionChoice::Default).is_ok();
                 if !by_levels {
                     arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
                 }

@@ -40,6 +40,10 @@ struct BlockWork {
     correction: Vec<f64>,
     trial: Vec<f64>,
     supports: Vec<Option<Vec<usize>>>,
+    /// Per coefficient: more than half its rows non-zero.
+    dense: Vec<bool>,
+    /// A sparse coefficient's `F_a[S_a, S_a]` (|S_a| × |S_a|).
+    sub: Vec<Vec<f64>>,
     fz: Vec<Vec<f64>>,
     sf: Vec<Vec<f64>>,
 }
@@ -55,6 +59,20 @@ impl BlockWork {
                 f.as_ref().map(|f| {
                     (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
                 })
+            })
+            .collect();
+        let dense: Vec<bool> =
+            supports.iter().map(|s| s.as_ref().is_some_and(|rows| 2 * rows.len() > n)).collect();
+        let sub = b
+            .coefficients
+            .iter()
+            .zip(&supports)
+            .zip(&dense)
+            .map(|((f, rows), dense)| match (f, rows) {
+                (Some(f), Some(rows)) if !dense => {
+                    rows.iter().flat_map(|&r| rows.iter().map(move |&c| f[r * n + c])).collect()
+                }
+                _ => Vec::new(),
             })
             .collect();
         let products = || {
@@ -80,6 +98,8 @@ impl BlockWork {
             fz: products(),
             sf: products(),
             supports,
+            dense,
+            sub,
         }
     }
 }
@@ -127,9 +147,14 @@ fn step_length(
     0.0
 }
 
-/// The Schur complement's block terms `M_ab += tr(F_a Z F_b S⁻¹) = ⟨S⁻¹ F_b, F_a Z⟩` over the
-/// rows where `F_a` is not zero: each `A_i` is made of a few 2 × 2 joint blocks, so this
-/// costs `O(k² n)` for them. Upper triangle, mirrored (`M` is symmetric).
+/// The Schur complement's block terms `M_ab += tr(F_a Z F_b S⁻¹)`, upper triangle mirrored
+/// (`M` is symmetric). A coefficient is *sparse* when at most half its rows are non-zero (a
+/// decoupled arm's `A_i`: one 2 × 2 joint block); a symmetric `F_a` is then zero outside
+/// `S_a × S_a`, `S_a` its rows, and kept as that sub-block. With `(F_a Z)` on the rows `S_a`:
+///
+/// - one of the pair dense, say `F_d`: `M = Σ_{r ∈ S_s} ⟨(S⁻¹ F_d)_r, (F_s Z)_r⟩`;
+/// - both sparse: `M = Σ_{i ∈ S_a, l ∈ S_b} S⁻¹_li Σ_{k ∈ S_b} (F_a Z)_ik (F_b)_kl`,
+///   `O(|S_a| |S_b|²)`: a handful of products for 2 × 2 joint blocks.
 #[inline(always)]
 fn add_block_schur(b: &Block, z: &[f64], w: &mut BlockWork, k: usize, schur: &mut [f64]) {
     let n = b.n;
@@ -137,45 +162,55 @@ fn add_block_schur(b: &Block, z: &[f64], w: &mut BlockWork, k: usize, schur: &mu
     for (a, fa) in b.coefficients.iter().enumerate() {
         let (Some(fa), Some(rows)) = (fa, &w.supports[a]) else { continue };
         let (fz, sf) = (&mut w.fz[a], &mut w.sf[a]);
-        if 2 * rows.len() > n {
+        if w.dense[a] {
             // Mostly dense (a routed arm's A_i): two matrix products.
             crate::dense::multiply_fast(fa, z, n, fz);
             crate::dense::multiply_fast(s_inv, fa, n, sf);
             continue;
         }
-        for &r in rows {
+        let (sub, m) = (&w.sub[a], rows.len());
+        for (i, &r) in rows.iter().enumerate() {
             let out = &mut fz[r * n..r * n + n];
             out.fill(0.0);
-            for (q, v) in fa[r * n..r * n + n].iter().enumerate() {
-                if *v != 0.0 {
-                    axpy(*v, &z[q * n..q * n + n], out);
-                }
-            }
-        }
-        for (row_inv, out) in s_inv.chunks_exact(n).zip(sf.chunks_exact_mut(n)) {
-            out.fill(0.0);
-            for &q in rows {
-                axpy(row_inv[q], &fa[q * n..q * n + n], out);
+            for (j, &q) in rows.iter().enumerate() {
+                axpy(sub[i * m + j], &z[q * n..q * n + n], out);
             }
         }
     }
     for a in 0..k {
-        let Some(rows) = &w.supports[a] else { continue };
+        let Some(rows_a) = &w.supports[a] else { continue };
         for bb in a..k {
-            if w.supports[bb].is_none() {
-                continue;
-            }
-            let (fz, sf) = (&w.fz[a], &w.sf[bb]);
-            let mut m = 0.0;
-            for &r in rows {
-                m += dot(&sf[r * n..r * n + n], &fz[r * n..r * n + n]);
-            }
+            let Some(rows_b) = &w.supports[bb] else { continue };
+            let m = match (w.dense[a], w.dense[bb]) {
+                (_, true) => pair_dense(n, rows_a, &w.sf[bb], &w.fz[a]),
+                (true, false) => pair_dense(n, rows_b, &w.sf[a], &w.fz[bb]),
+                (false, false) => {
+                    let (fz, sub, mb) = (&w.fz[a], &w.sub[bb], rows_b.len());
+                    let mut m = 0.0;
+                    for &i in rows_a {
+                        for (l, &ql) in rows_b.iter().enumerate() {
+                            let mut v = 0.0;
+                            for (kk, &qk) in rows_b.iter().enumerate() {
+                                v += fz[i * n + qk] * sub[kk * mb + l];
+                            }
+                            m += s_inv[ql * n + i] * v;
+                        }
+                    }
+                    m
+                }
+            };
             schur[a * k + bb] += m;
             if bb != a {
                 schur[bb * k + a] += m;
             }
         }
     }
+}
+
+/// `Σ_{r ∈ rows} ⟨sf_r, fz_r⟩` (rows of n).
+#[inline(always)]
+fn pair_dense(n: usize, rows: &[usize], sf: &[f64], fz: &[f64]) -> f64 {
+    rows.iter().map(|&r| dot(&sf[r * n..r * n + n], &fz[r * n..r * n + n])).sum()
 }
 
 /// The vectors of a run (rows, variables), allocated once per run.
