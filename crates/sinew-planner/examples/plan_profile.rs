@@ -3,7 +3,7 @@
 //! difference divided by N), and prints the iterations and the value of the last plan.
 //!
 //! `cargo run --release -p sinew-planner --example plan_profile -- MODEL OBJECTIVE N METHOD`
-//! with MODEL `decoupled` or `routed`, OBJECTIVE one of `stiffness-along`, `compliance-along`,
+//! with MODEL `decoupled`, `routed` or `chain25` (the bench's 50-DOF chain), OBJECTIVE one of `stiffness-along`, `compliance-along`,
 //! `min-stiffness`, `volume`, `least-tension`, and METHOD `ipm` or `bundle`; with METHOD
 //! `along`, N times the bench's 100-step 1 kHz trajectory, warm-started (instructions per step:
 //! the difference divided by 100 N).
@@ -36,10 +36,20 @@ fn main() {
         _ => Method::InteriorPoint,
     };
     let (robot, routing) = cdhrm5::robot_and_routing(model);
+    let mut q = cdhrm5::LOADED_POSE.to_vec();
+    let mut f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    // MODEL `chain25`: the bench's 25-joint decoupled chain (50 DOF, weightless, 0.022 N at
+    // the tip).
+    let (robot, routing) = if args.get(1).map(String::as_str) == Some("chain25") {
+        let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
+        q = (0..50).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+        f0 = Vector6::new(0.0, 0.02, 0.01, 0.0, 0.0, 0.0);
+        (robot.with_gravity(Vector3::zeros()), routing)
+    } else {
+        (robot, routing)
+    };
     let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
     let mut data = PlannerData::new(&planner);
-    let q = cdhrm5::LOADED_POSE;
-    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let requirements = Requirements::default();
     if args.get(4).map(String::as_str) == Some("along") {
         // The bench's trajectory: joints at up to 3 rad/s about the loaded pose, 1 kHz.
@@ -48,7 +58,7 @@ fn main() {
                 q: (0..10)
                     .map(|j| {
                         let omega = 0.5 + 14.5 * j as f64 / 9.0;
-                        q[j] + 0.2 * (omega * k as f64 * 1e-3).sin()
+                        cdhrm5::LOADED_POSE[j] + 0.2 * (omega * k as f64 * 1e-3).sin()
                     })
                     .collect(),
                 f0,
