@@ -75,7 +75,18 @@ fn main() {
         println!("{warm} of 100 steps warm");
         return;
     }
-    let settings = PlanSettings { method, ..PlanSettings::default() };
+    let mut settings = PlanSettings { method, ..PlanSettings::default() };
+    // A fifth argument caps the iterations (the plans then end NotConverged): instructions per
+    // iteration by difference.
+    let cap: Option<usize> = args.get(5).map(|c| c.parse().expect("a cap"));
+    if let Some(cap) = cap {
+        settings.max_iterations = cap;
+        for _ in 0..plans {
+            let _ =
+                planner.plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings);
+        }
+        return;
+    }
     let mut last = None;
     for _ in 0..plans {
         let plan = planner

@@ -64,38 +64,42 @@ macro_rules! fixed_size {
     };
 }
 
-/// Overwrite the lower triangle of the symmetric `a` (n × n) with its Cholesky factor `L`
-/// (`a = L Lᵀ`); the strict upper triangle is left as it was. `false` (and `a` spoilt) when
-/// `a` is not positive definite to working precision.
+/// Overwrite the lower triangle of the symmetric `a` (n × n, only its lower triangle read) with
+/// its Cholesky factor `L` (`a = L Lᵀ`); the strict upper triangle is scratch afterwards.
+/// `false` (and `a` spoilt) when `a` is not positive definite to working precision.
 ///
-/// Row-oriented (each entry of `L` the dot product of two row prefixes), the arithmetic of
-/// Algorithm 4.2.1 of Golub and Van Loan; fixed-size kernels up to n = 17.
+/// Above n = 17 row-oriented (each entry of `L` the dot product of two row prefixes, Algorithm
+/// 4.2.1 of Golub and Van Loan); up to n = 17 right-looking on fixed-size rows.
 #[inline(always)]
 pub(crate) fn cholesky(a: &mut [f64], n: usize) -> bool {
     fixed_size!(n, cholesky_fixed(a), cholesky_dynamic(a, n))
 }
 
+/// The fixed-size factorisation is right-looking: after each pivot the trailing rows are
+/// updated in full (`row_i −= L_ij L_j` over all N columns, `L_j` zero up to j), which keeps
+/// every loop at the fixed length N, at the price of overwriting the strict upper triangle.
 #[inline(always)]
 fn cholesky_fixed<const N: usize>(a: &mut [f64]) -> bool {
     let (rows, _) = a[..N * N].as_chunks_mut::<N>();
     for j in 0..N {
-        let row_j = rows[j];
-        let mut d = row_j[j];
-        for p in 0..j {
-            d -= row_j[p] * row_j[p];
-        }
+        let d = rows[j][j];
         if !(d > 0.0 && d.is_finite()) {
             return false;
         }
         let d = d.sqrt();
         rows[j][j] = d;
         let inv = 1.0 / d;
-        for row_i in rows[j + 1..].iter_mut() {
-            let mut v = row_i[j];
-            for p in 0..j {
-                v -= row_i[p] * row_j[p];
+        let mut column = [0.0; N];
+        for i in j + 1..N {
+            let v = rows[i][j] * inv;
+            rows[i][j] = v;
+            column[i] = v;
+        }
+        for i in j + 1..N {
+            let li = column[i];
+            for c in 0..N {
+                rows[i][c] -= li * column[c];
             }
-            row_i[j] = v * inv;
         }
     }
     true
