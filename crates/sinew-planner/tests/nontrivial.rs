@@ -592,6 +592,32 @@ fn a_binding_total_budget_is_spent_where_it_stiffens_most() {
     }
 }
 
+/// The least total tension of one common level `s` for every joint that meets the
+/// requirements (a scan of `s` in steps of 0.05, then bisection: the floors grow with `s`
+/// here): what a planner that only raises every level alike until the floor holds would
+/// answer. None where no common level meets them.
+fn uniform_meeting(judge: &mut Judge<'_>, requirements: &Requirements) -> Option<f64> {
+    let n = judge.joints();
+    let meets = |judge: &mut Judge<'_>, s: f64| {
+        let f = judge.at_levels(&vec![s; n])?;
+        judge.value(Objective::LeastTension, requirements, &f)
+    };
+    let first = (0..=20).map(|i| f64::from(i) / 20.0).find(|&s| meets(judge, s).is_some())?;
+    let (mut lo, mut hi) = ((first - 0.05).max(0.0), first);
+    if lo == hi {
+        return meets(judge, hi);
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if meets(judge, mid).is_some() {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    meets(judge, hi)
+}
+
 /// Per-joint budgets of 0.6 of the free optimum's sums on joints 1 and 5 (0 and 4): the
 /// all-levels-1 point breaks them, the plan spends both to 1e-4. Catches a planner that
 /// returns the top of every interval, one that drops or misindexes the per-joint rows (a cap
@@ -667,5 +693,99 @@ fn held_levels_are_held_while_the_other_joints_are_optimised() {
             let searched = search(&mut judge, &plan, &requirements, seed);
             report(&name, &plan, None, &searched, started);
         }
+    }
+}
+
+/// Least tension with the floor `λ_min(K_fd) ≥ k_min`, 0.8 of the best reachable (at 0.5,
+/// decoupled, the stability margin binds first and the floor is slack): the plan's
+/// total is far below the all-levels-1 point's (decoupled; routed, that point does not
+/// balance) and below the least common level that meets the floor, the floor binds (1e-4) and
+/// the least-total tensions break it. Catches a planner that answers the top (too much
+/// tension), the least-total tensions (floor broken), or raises every level alike.
+#[test]
+fn least_tension_meets_a_stiffness_floor_with_equality() {
+    for (m, model) in cdhrm5::MODELS.into_iter().enumerate() {
+        let case = cdhrm5_case(model);
+        let planner = case.planner();
+        let mut pdata = PlannerData::new(&planner);
+        let arm = planner.arm();
+        let mut judge = Judge::new(&case, arm);
+        let started = Instant::now();
+        let best =
+            plan(&case, &planner, &mut pdata, Objective::MinStiffness, &Requirements::default());
+        let k_min = 0.8 * best.value;
+        let requirements = Requirements { k_min: Some(k_min), ..Requirements::default() };
+        let objective = Objective::LeastTension;
+        let plan = plan(&case, &planner, &mut pdata, objective, &requirements);
+        let name = format!("{} k_min {k_min:.4} N/m", case.name);
+        check_candidate(&case, arm, &plan, &requirements);
+        let reached = least(&plan.k_fd.unwrap());
+        assert!(reached <= k_min * (1.0 + 1e-4), "{name}: λ_min {reached}, floor not binding");
+        let (top, v_top) = judge.top(objective, &requirements);
+        match model {
+            PatternModel::Decoupled => {
+                assert_far_better(&name, &plan, v_top.expect("levels 1 meet the floor"), "levels 1")
+            }
+            PatternModel::Routed => assert!(top.is_none(), "{name}: levels 1 balance"),
+        }
+        let lowest = judge.lowest(&[]);
+        assert!(
+            judge.value(objective, &requirements, &lowest).is_none(),
+            "{name}: least total meets"
+        );
+        let uniform = uniform_meeting(&mut judge, &requirements);
+        println!("{name}: λ_min {reached}, uniform levels {uniform:?}");
+        if let Some(u) = uniform {
+            assert_far_better(&name, &plan, u, "the least common level");
+        }
+        let searched = search(&mut judge, &plan, &requirements, 400 + m as u64);
+        report(&name, &plan, v_top, &searched, started);
+    }
+}
+
+/// Least tension with `K_fd ⪰ K_des`, half the `K_fd` of the stiffest-least-direction plan:
+/// as the floor, with the matrix floor binding (`λ_min(K_fd − K_des)` within 1e-4 of
+/// `λ_min(K_des)` of 0). Catches a planner that answers the top, the least-total tensions, a
+/// common level, or checks only `K_des`'s diagonal or smallest eigenvalue (then
+/// `K_fd − K_des` would have a negative eigenvalue, which the candidate check catches).
+#[test]
+fn least_tension_meets_a_desired_stiffness_with_equality() {
+    for (m, model) in cdhrm5::MODELS.into_iter().enumerate() {
+        let case = cdhrm5_case(model);
+        let planner = case.planner();
+        let mut pdata = PlannerData::new(&planner);
+        let arm = planner.arm();
+        let mut judge = Judge::new(&case, arm);
+        let started = Instant::now();
+        let best =
+            plan(&case, &planner, &mut pdata, Objective::MinStiffness, &Requirements::default());
+        let k_des = 0.5 * best.k_fd.unwrap();
+        let k_des = 0.5 * (k_des + k_des.transpose());
+        let requirements = Requirements { k_des: Some(k_des), ..Requirements::default() };
+        let objective = Objective::LeastTension;
+        let plan = plan(&case, &planner, &mut pdata, objective, &requirements);
+        let name = format!("{} K_des", case.name);
+        check_candidate(&case, arm, &plan, &requirements);
+        let slack = least(&(plan.k_fd.unwrap() - k_des));
+        assert!(slack <= 1e-4 * least(&k_des), "{name}: λ_min(K_fd − K_des) {slack}, not binding");
+        let (top, v_top) = judge.top(objective, &requirements);
+        match model {
+            PatternModel::Decoupled => {
+                assert_far_better(&name, &plan, v_top.expect("levels 1 meet K_des"), "levels 1")
+            }
+            PatternModel::Routed => assert!(top.is_none(), "{name}: levels 1 balance"),
+        }
+        let lowest = judge.lowest(&[]);
+        assert!(
+            judge.value(objective, &requirements, &lowest).is_none(),
+            "{name}: least total meets"
+        );
+        let uniform = uniform_meeting(&mut judge, &requirements);
+        println!("{name}: λ_min(K_fd − K_des) {slack}, uniform levels {uniform:?}");
+        if let Some(u) = uniform {
+            assert_far_better(&name, &plan, u, "the least common level");
+        }
+        let searched = search(&mut judge, &plan, &requirements, 500 + m as u64);
+        report(&name, &plan, v_top, &searched, started);
     }
 }
