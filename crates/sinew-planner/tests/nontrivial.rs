@@ -908,3 +908,42 @@ fn where_tension_softens_the_joints_the_optimum_is_not_the_top() {
         report(&name, &plan, &v_top.to_string(), &searched, started);
     }
 }
+
+/// The robots beyond the closed form: ua3x4 (four cables per universal joint, a 6-dimensional
+/// equilibrium set) and the planar snake (shared cable, 1-DOF joints, `J_x` of rank 3 so no
+/// `K_fd`: the compliance along y in its bending plane, and least tension with a margin). No
+/// levels there, so checks 2 and 3 only: random tensions over the box of λ and around the
+/// plan's λ, grids around it, and the pipeline at the plan. Catches a planner whose general
+/// path (no levels, cables crossing joints) answers a point that is not optimal, not
+/// balanced, or not what the pipeline says.
+#[test]
+fn plans_on_ua3x4_and_the_planar_snake_survive_the_searches() {
+    let load = |name: &str, q: Vec<f64>| {
+        let dir = cdhrm5::workspace_root().join("robots").join(name);
+        let robot = sinew_robot::load(&dir).unwrap();
+        let routing = sinew_routing::load(&dir, &robot).unwrap();
+        let f0 = Vector6::new(0.0, 2.0, 0.0, 0.0, 0.0, 0.0);
+        Case { name: name.to_owned(), robot, routing, q, f0 }
+    };
+    let ua = load("ua3x4", vec![0.2, -0.3, 0.25, 0.1, -0.15, 0.3]);
+    let snake = load("planar-snake", vec![0.3, -0.2, 0.25, -0.1]);
+    let margin = Requirements { margin: 0.2, ..Requirements::default() };
+    let cases = [
+        (&ua, Objective::StiffnessAlong(Vector3::y()), Requirements::default()),
+        (&ua, Objective::MinStiffness, Requirements::default()),
+        (&snake, Objective::ComplianceAlong(Vector3::y()), Requirements::default()),
+        (&snake, Objective::LeastTension, margin),
+    ];
+    for (c, (case, objective, requirements)) in cases.into_iter().enumerate() {
+        let started = Instant::now();
+        let planner = case.planner();
+        let mut pdata = PlannerData::new(&planner);
+        let arm = planner.arm();
+        assert!(!arm.statics().has_levels(), "{}: levels", case.name);
+        let plan = plan(case, &planner, &mut pdata, objective, &requirements);
+        check_candidate(case, arm, &plan, &requirements);
+        let mut judge = Judge::new(case, arm);
+        let searched = search(&mut judge, &plan, &requirements, 700 + c as u64);
+        report(&case.name, &plan, "none (no levels)", &searched, started);
+    }
+}
