@@ -363,7 +363,7 @@ fn grid_points(centre: &[f64], half: f64, n: usize) -> Vec<Vec<f64>> {
 }
 
 /// A brute-force grid against the plan. With levels: the whole cube of the free levels (about
-/// 3000 points), then a fine grid of half-width 0.01 around the plan's levels; without: grids of
+/// 8000 points), then a fine grid of half-width 0.01 around the plan's levels; without: grids of
 /// 5 points per axis of λ around the plan's λ at half-widths 5, 0.5 and 0.05 N (most leave the
 /// limits where the plan sits on some). Budgets as in
 /// the random search (pulled to their face). Panics on a point that beats the plan by more
@@ -381,7 +381,7 @@ fn grid_search(
         Some(at) if judge.levels => {
             let free: Vec<usize> =
                 (0..judge.joints()).filter(|j| !held.iter().any(|(h, _)| h == j)).collect();
-            let n = (3000f64.powf(1.0 / free.len() as f64).floor() as usize).max(2);
+            let n = (8000f64.powf(1.0 / free.len() as f64).floor() as usize).max(2);
             let centre_free: Vec<f64> = free.iter().map(|&j| at[j]).collect();
             for (centre, half, n) in
                 [(vec![0.5; free.len()], 0.5, n), (centre_free, 0.01, n.min(5))]
@@ -434,7 +434,7 @@ fn grid_search(
 /// Both searches.
 fn search(judge: &mut Judge<'_>, plan: &Plan, requirements: &Requirements, seed: u64) -> Searched {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (random, best_random) = random_search(judge, plan, requirements, 3000, &mut rng);
+    let (random, best_random) = random_search(judge, plan, requirements, 5000, &mut rng);
     let (grid, best_grid) = grid_search(judge, plan, requirements);
     let best = match (best_random, best_grid) {
         (Some(a), Some(b)) => Some(if advantage(plan.objective, a, b) > 0.0 { a } else { b }),
