@@ -30,9 +30,10 @@
 //! [`Planner::plan_along`] re-plans along a trajectory, warm-started ([`Step`], [`RateLimit`],
 //! [`AlongStep`]).
 //!
-//! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). Both
-//! methods allocate inside their iterations (the interior-point method its small dense buffers
-//! per run, clarabel each subproblem).
+//! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). The
+//! interior-point method sizes its buffers once per run and allocates nothing per iteration
+//! (`tests/allocations.rs`); a plan's set-up still allocates (the equilibrium set, the pencil,
+//! the blocks of each phase), and the bundle method's clarabel allocates each subproblem.
 #![deny(missing_docs)]
 
 mod along;
