@@ -5,7 +5,7 @@
 //! re-evaluated by one more tension stage and the end stage.
 
 use faer::Mat;
-use nalgebra::Vector6;
+use nalgebra::{Matrix6, Vector6};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 
@@ -193,7 +193,6 @@ impl Planner {
         let plan = self.answer(
             &mut data.stiffness,
             &set,
-            &pencil,
             objective,
             requirements,
             &lambda,
@@ -254,14 +253,14 @@ impl Planner {
         Ok((lambda, upper, stable_iterations + floor_iterations + last_iterations))
     }
 
-    /// The plan at `λ`, evaluated by the pipeline itself at its tensions (no new pose stage),
-    /// with the gap to the bound `upper` of the maximised objective.
+    /// The plan at `λ`, evaluated by the pipeline itself at its tensions (no new pose stage):
+    /// its value, `C_x`, `K_fd` and margin are the pipeline's, with the gap to the bound
+    /// `upper` of the maximised objective.
     #[allow(clippy::too_many_arguments)]
     fn answer(
         &self,
         sd: &mut ArmStiffnessData,
         set: &EquilibriumSet,
-        pencil: &Pencil,
         objective: Objective,
         requirements: &Requirements,
         lambda: &[f64],
@@ -278,24 +277,27 @@ impl Planner {
         arm.solve_end(sd)?;
         let outcome = sd.outcome().ok_or(PlanError::NoEndStiffness)?;
         let min_eigenvalue = outcome.margin()?;
-        let no_stable = || PlanError::NoStableTensions {
-            margin: requirements.margin,
-            best: min_eigenvalue,
-            budget: requirements.budget.is_some(),
+        let Some(c) = outcome.compliance() else {
+            return Err(PlanError::NoStableTensions {
+                margin: requirements.margin,
+                best: min_eigenvalue,
+                budget: requirements.budget.is_some(),
+            });
         };
-        let end = pencil.end(lambda).ok_or_else(no_stable)?;
+        let c_x = Matrix6::from_fn(|r, col| 0.5 * (c[(r, col)] + c[(col, r)]));
+        let k_fd = outcome.k_fd().map(|k| 0.5 * (k + k.transpose()));
         let total: f64 = tensions.iter().sum();
         // The objective in its maximised sense at the answer.
         let maximised = match objective {
-            Objective::StiffnessAlong(u) => {
-                let w = Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0);
-                end.stiffness_form(pencil, &w).ok_or(PlanError::NoEndStiffness)?.0
-            }
-            Objective::ComplianceAlong(u) => end.compliance_form(pencil, &u).0,
+            Objective::StiffnessAlong(u) => u.dot(&(k_fd.ok_or(PlanError::NoEndStiffness)? * u)),
+            Objective::ComplianceAlong(u) => -u.dot(&(c_x.fixed_view::<3, 3>(0, 0) * u)),
             Objective::MinStiffness => {
-                end.least_stiffness(pencil, None).ok_or(PlanError::NoEndStiffness)?.0
+                k_fd.ok_or(PlanError::NoEndStiffness)?.symmetric_eigenvalues().min()
             }
-            Objective::Volume => end.log_volume(pencil).ok_or(PlanError::NoEndStiffness)?.0,
+            Objective::Volume => {
+                let l = k_fd.and_then(|k| k.cholesky()).ok_or(PlanError::NoEndStiffness)?.l();
+                2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>()
+            }
             Objective::LeastTension => -total,
         };
         // The bound's own rounding: a few ulps of the value.
@@ -313,8 +315,8 @@ impl Planner {
             lambda: lambda.to_vec(),
             tensions,
             levels,
-            k_fd: end.k_fd(),
-            c_x: end.c_x,
+            k_fd,
+            c_x,
             min_eigenvalue,
             iterations,
         })
