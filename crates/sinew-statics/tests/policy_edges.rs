@@ -67,17 +67,18 @@ fn a_tension_a_hair_off_its_limit_is_put_on_it_and_one_clearly_inside_is_kept() 
         600.0 + 1e-5, // outside by rounding: f_max
         20.0 - 1e-5,  // outside by rounding: f_min
         300.0,
+        20.0 + 6e-7, // kept: just beyond 5.8e-7 (a width of f_max + f_min, 620 N, would snap it)
     ];
-    let expected = [20.0, 20.0 + 1e-6, 600.0, 600.0 - 1e-6, 600.0, 20.0, 300.0];
+    let expected = [20.0, 20.0 + 1e-6, 600.0, 600.0 - 1e-6, 600.0, 20.0, 300.0, 20.0 + 6e-7];
     let (set, groups) = diagonal(&wanted, LIMITS);
     for policy in TensionPolicy::ALL {
-        let mut f = vec![f64::NAN; 7];
-        let d = distribute_with_policy(&set, policy, &groups, &names(7), &mut f).unwrap();
+        let mut f = vec![f64::NAN; 8];
+        let d = distribute_with_policy(&set, policy, &groups, &names(8), &mut f).unwrap();
         for c in [0, 2, 4, 5] {
             assert_eq!(f[c], expected[c], "{policy:?}: cable {c} at {}", f[c]);
         }
-        for c in [1, 3, 6] {
-            assert!((f[c] - expected[c]).abs() <= 1e-11, "{policy:?}: cable {c} at {}", f[c]);
+        for c in [1, 3, 6, 7] {
+            assert!((f[c] - expected[c]).abs() <= 1e-12, "{policy:?}: cable {c} at {}", f[c]);
             assert!(f[c] != LIMITS[0] && f[c] != LIMITS[1], "{policy:?}: cable {c} snapped");
         }
         let objective = match policy {
@@ -155,4 +156,125 @@ fn a_refusal_names_the_cable_farthest_outside_its_limits() {
     assert!((needed - 20.0).abs() <= 1e-10, "{needed}");
     assert!((range[0] + 24.0).abs() <= 1e-10 && (range[1] + 0.8).abs() <= 1e-10, "{range:?}");
     assert_eq!((at_max, at_min), (&vec![], &vec!["c1".to_owned()]));
+}
+
+#[test]
+fn every_objective_is_the_one_of_the_answer() {
+    // Unique tensions (580, 300, 45) N: Σ f = 925 N, |f| = √(580² + 300² + 45²) N, and the
+    // least distance to a limit is 20 N (cable 1 to f_max; cable 3 is 25 N above f_min).
+    let (set, groups) = diagonal(&[580.0, 300.0, 45.0], LIMITS);
+    for policy in TensionPolicy::ALL {
+        let mut f = vec![f64::NAN; 3];
+        let d = distribute_with_policy(&set, policy, &groups, &names(3), &mut f).unwrap();
+        let expected = match policy {
+            TensionPolicy::LeastTotal => 925.0,
+            TensionPolicy::LeastNorm => (580.0_f64 * 580.0 + 300.0 * 300.0 + 45.0 * 45.0).sqrt(),
+            TensionPolicy::Safest => 20.0,
+        };
+        assert!((d.objective - expected).abs() <= 1e-12 * expected, "{policy:?}: {}", d.objective);
+    }
+}
+
+/// The cables' torque `−J_cᵀ f · δq` over the box of limits: `[least, greatest]`.
+fn torque_range(j: &Mat<f64>, dq: &[f64], limits: [f64; 2]) -> [f64; 2] {
+    let (mut lo, mut hi) = (0.0, 0.0);
+    for c in 0..j.nrows() {
+        let w: f64 = (0..dq.len()).map(|d| j[(c, d)] * dq[d]).sum();
+        let (a, b) = (-w * limits[0], -w * limits[1]);
+        lo += a.min(b);
+        hi += a.max(b);
+    }
+    [lo, hi]
+}
+
+#[test]
+fn every_policy_refuses_a_load_beyond_the_limits_with_the_least_total_certificate() {
+    // One universal joint with three cables at 120° (a set of dimension 1) and a second one
+    // beside it, holding 0.5 N m: loads of 15 N m on joint 1 need more than 600 N of a cable.
+    // The safest program is feasible (its margin goes negative), so its answer is outside the
+    // limits and its refusal reads the least-total program's certificate: every policy then
+    // reports the same, and it is a true one (recomputed here from J_c, T0 and the limits).
+    let s = 0.02 * 3.0_f64.sqrt() / 2.0;
+    let rows: [[f64; 2]; 3] = [[0.02, 0.0], [-0.01, -s], [-0.01, s]];
+    let j = Mat::from_fn(6, 4, |r, c| if (r < 3) == (c < 2) { rows[r % 3][c % 2] } else { 0.0 });
+    let groups = [0..2, 2..4];
+    for t0 in [[-15.0, 0.0, 0.5, 0.0], [-12.0, -12.0, 0.0, -0.5], [3.0, 16.0, 0.2, 0.2]] {
+        let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 6], &groups).unwrap();
+        assert_eq!(set.dimension(), 2);
+        let mut answers = Vec::new();
+        for policy in TensionPolicy::ALL {
+            let mut f = vec![f64::NAN; 6];
+            let Err(StaticsError::NoEquilibrium(why)) =
+                distribute_with_policy(&set, policy, &groups, &names(6), &mut f)
+            else {
+                panic!("{t0:?} {policy:?}: answered {f:?}");
+            };
+            assert_eq!(why.joints, vec![0], "{t0:?} {policy:?}: {why}");
+            let NoEquilibriumCause::Limits { direction, needed, range, .. } = &why.cause else {
+                panic!("{why}")
+            };
+            // Largest component 1, in the sign of T0, joint 2 still.
+            let largest = direction.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            assert!((largest - 1.0).abs() <= 1e-12, "{direction:?}");
+            assert!(direction[2..].iter().all(|&v| v == 0.0), "{direction:?}");
+            let demand: f64 = (0..4).map(|d| t0[d] * direction[d]).sum();
+            assert!((needed - demand).abs() <= 1e-9 * demand.abs(), "{needed} vs {demand}");
+            let expected = torque_range(&j, direction, LIMITS);
+            for k in 0..2 {
+                assert!((range[k] - expected[k]).abs() <= 1e-9, "{range:?} vs {expected:?}");
+            }
+            assert!(*needed > range[1] + 1e-3 || *needed < range[0] - 1e-3, "{why}");
+            answers.push(why);
+        }
+        assert_eq!(answers[0], answers[2], "{t0:?}: safest and least total differ");
+    }
+}
+
+#[test]
+fn a_load_just_beyond_one_face_is_refused_along_that_face_s_normal() {
+    // Three cables at 120° on one universal joint (a set of dimension 1). The torques within
+    // the limits form a hexagon; the face where cable 1 is at f_min and cable 3 at f_max (cable
+    // 2 anywhere) has the normal n ⊥ J_c row 2, n = (√3/2, −1/2). A load 0.05 N m beyond the
+    // middle of that face is refused along n and nowhere else within 1°: the face is 11.6 N m
+    // long, and neither DOF alone (60° and 30° away) certifies it. The solver's certificate
+    // is then the one reported: its cable weights must be read as w = z_upper − z_lower.
+    let s = 0.02 * 3.0_f64.sqrt() / 2.0;
+    let rows: [[f64; 2]; 3] = [[0.02, 0.0], [-0.01, -s], [-0.01, s]];
+    let j = Mat::from_fn(3, 2, |r, c| rows[r][c]);
+    let n = [3.0_f64.sqrt() / 2.0, -0.5];
+    // The middle of the face: tensions (20, 310, 600), torque −J_cᵀ f.
+    let middle = [20.0, 310.0, 600.0];
+    let torque = |d: usize| -(0..3).map(|c| rows[c][d] * middle[c]).sum::<f64>();
+    let t0 = [torque(0) + 0.05 * n[0], torque(1) + 0.05 * n[1]];
+    let groups = [0..2];
+    let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 3], &groups).unwrap();
+    assert_eq!(set.dimension(), 1);
+    for policy in TensionPolicy::ALL {
+        let mut f = vec![f64::NAN; 3];
+        let Err(StaticsError::NoEquilibrium(why)) =
+            distribute_with_policy(&set, policy, &groups, &names(3), &mut f)
+        else {
+            panic!("{policy:?}: answered {f:?}");
+        };
+        assert_eq!(why.joints, vec![0], "{policy:?}: {why}");
+        let NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } = &why.cause
+        else {
+            panic!("{why}")
+        };
+        let size = direction[0].hypot(direction[1]);
+        let cos = (direction[0] * n[0] + direction[1] * n[1]) / size;
+        assert!(cos >= 1f64.to_radians().cos(), "{policy:?}: {direction:?} is not along {n:?}");
+        let demand = t0[0] * direction[0] + t0[1] * direction[1];
+        assert!((needed - demand).abs() <= 1e-9 * demand.abs(), "{needed} vs {demand}");
+        let expected = torque_range(&j, direction, LIMITS);
+        for k in 0..2 {
+            assert!((range[k] - expected[k]).abs() <= 1e-9, "{range:?} vs {expected:?}");
+        }
+        // Beyond the top by about 0.05 N m per unit of |δq|.
+        let beyond = (needed - range[1]) / size;
+        assert!((0.03..=0.05 + 1e-9).contains(&beyond), "{policy:?}: {why}");
+        // Pulling harder on cable 1 and slacking cable 3 gives more torque along n: cable 1 at
+        // f_min and cable 3 at f_max hold back. Cable 2 does not move along n.
+        assert_eq!((at_max, at_min), (&vec!["c3".to_owned()], &vec!["c1".to_owned()]), "{why}");
+    }
 }
