@@ -156,6 +156,24 @@ fn a_refusal_names_the_cable_farthest_outside_its_limits() {
     assert!((needed - 20.0).abs() <= 1e-10, "{needed}");
     assert!((range[0] + 24.0).abs() <= 1e-10 && (range[1] + 0.8).abs() <= 1e-10, "{range:?}");
     assert_eq!((at_max, at_min), (&vec![], &vec!["c1".to_owned()]));
+    // f = (10, 650) N: cable 2 is 50 N above f_max, farther out than cable 1 (10 N below
+    // f_min); along cable 2 alone the shortfall is 50 N per newton, more than along DOF 2
+    // alone (60/√2 ≈ 42 N). Reported along δq = (−1, 1): T0 · δq = 2a f_2 = 26 N m, cable 2
+    // gives 2a [20, 600] = [0.8, 24] N m.
+    let f = [10.0, 650.0];
+    let t0 = [-a * (f[0] + f[1]), -a * (f[0] - f[1])];
+    let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 2], &groups).unwrap();
+    let why = refusal(&set, &groups);
+    let NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } = &why.cause else {
+        panic!("{why}")
+    };
+    assert!(
+        (direction[0] + 1.0).abs() <= 1e-12 && (direction[1] - 1.0).abs() <= 1e-12,
+        "{direction:?}"
+    );
+    assert!((needed - 26.0).abs() <= 1e-10, "{needed}");
+    assert!((range[0] - 0.8).abs() <= 1e-10 && (range[1] - 24.0).abs() <= 1e-10, "{range:?}");
+    assert_eq!((at_max, at_min), (&vec!["c2".to_owned()], &vec![]));
 }
 
 #[test]
