@@ -296,3 +296,56 @@ fn a_load_just_beyond_one_face_is_refused_along_that_face_s_normal() {
         assert_eq!((at_max, at_min), (&vec!["c3".to_owned()], &vec!["c1".to_owned()]), "{why}");
     }
 }
+
+#[test]
+fn the_least_norm_tensions_inside_the_limits_are_exactly_the_particular_ones() {
+    // Two cables pulling the same way on one DOF (J_c = [0.02; 0.02]) hold 4 N m with
+    // f_p = (100, 100) N, inside the limits: the least |f| is f_p itself, λ = 0 exactly (the
+    // polish of an answer with no limit active), not the solver's λ ≈ 0.
+    let j = Mat::from_fn(2, 1, |_, _| 0.02);
+    let groups = [0..1];
+    let set = EquilibriumSet::new(j.as_ref(), &[-4.0], &[LIMITS; 2], &groups).unwrap();
+    assert_eq!(set.dimension(), 1);
+    for c in 0..2 {
+        assert!((set.particular()[c] - 100.0).abs() <= 1e-12, "{:?}", set.particular());
+    }
+    let mut f = vec![f64::NAN; 2];
+    let d =
+        distribute_with_policy(&set, TensionPolicy::LeastNorm, &groups, &names(2), &mut f).unwrap();
+    assert_eq!(d.lambda, vec![0.0]);
+    assert_eq!(f, set.particular());
+    assert!(d.iterations > 0);
+    assert!((d.objective - 200.0_f64.sqrt() * 10.0).abs() <= 1e-12, "{}", d.objective);
+    // The safest tensions are the same (80 N from f_min each, any shift brings one closer).
+    let d =
+        distribute_with_policy(&set, TensionPolicy::Safest, &groups, &names(2), &mut f).unwrap();
+    assert!(f.iter().all(|v| (v - 100.0).abs() <= 1e-9), "{f:?}");
+    assert!((d.objective - 80.0).abs() <= 1e-9, "{}", d.objective);
+}
+
+#[test]
+fn the_least_total_answer_is_on_its_vertex_exactly_with_wide_limits() {
+    // Three cables at 120° with limits [20, 20 000] N (the snap band, 1e-9 of the width, is
+    // 2e-5 N here). The least total is f_p + s (1, 1, 1) with the least tension at f_min
+    // exactly, put there by the polish (f_p from J_c (J_cᵀ J_c)⁻¹ here).
+    let s = 0.02 * 3.0_f64.sqrt() / 2.0;
+    let rows: [[f64; 2]; 3] = [[0.02, 0.0], [-0.01, -s], [-0.01, s]];
+    let j = Mat::from_fn(3, 2, |r, c| rows[r][c]);
+    let groups = [0..2];
+    let limits = [20.0, 20_000.0];
+    for t0 in [[-50.0, 30.0], [120.0, -7.5], [-3.0, -260.0]] {
+        let set = EquilibriumSet::new(j.as_ref(), &t0, &[limits; 3], &groups).unwrap();
+        // J_cᵀ J_c = 6e-4 I: f_p = −J_c T0 / 6e-4.
+        let fp: Vec<f64> =
+            (0..3).map(|c| -(rows[c][0] * t0[0] + rows[c][1] * t0[1]) / 6e-4).collect();
+        let shift = limits[0] - fp.iter().fold(f64::INFINITY, |a, &v| a.min(v));
+        let mut f = vec![f64::NAN; 3];
+        let d = distribute_with_policy(&set, TensionPolicy::LeastTotal, &groups, &names(3), &mut f)
+            .unwrap();
+        assert_eq!(f.iter().fold(f64::INFINITY, |a, &v| a.min(v)), limits[0], "{t0:?}: {f:?}");
+        for c in 0..3 {
+            assert!((f[c] - (fp[c] + shift)).abs() <= 1e-9, "{t0:?}: {f:?}");
+        }
+        assert!((d.objective - f.iter().sum::<f64>()).abs() <= 1e-9, "{t0:?}");
+    }
+}
