@@ -174,6 +174,21 @@ fn a_refusal_names_the_cable_farthest_outside_its_limits() {
     assert!((needed - 26.0).abs() <= 1e-10, "{needed}");
     assert!((range[0] - 0.8).abs() <= 1e-10 && (range[1] - 24.0).abs() <= 1e-10, "{range:?}");
     assert_eq!((at_max, at_min), (&vec!["c2".to_owned()], &vec![]));
+    // f = (−30, 660) N: 50 N below and 60 N above. Along DOF 2 alone (w ∝ (1, −1), both
+    // cables) the shortfall per newton, 110/√2 ≈ 78 N, beats cable 2 alone (60 N): reported
+    // along δq = (0, 1), T0 · δq = −a (f_1 − f_2) = 13.8 N m, the cables give ±2a × 290 N =
+    // ±11.6 N m, cable 2 at f_max and cable 1 at f_min.
+    let f = [-30.0, 660.0];
+    let t0 = [-a * (f[0] + f[1]), -a * (f[0] - f[1])];
+    let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 2], &groups).unwrap();
+    let why = refusal(&set, &groups);
+    let NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } = &why.cause else {
+        panic!("{why}")
+    };
+    assert!(direction[0].abs() <= 1e-12 && (direction[1] - 1.0).abs() <= 1e-12, "{direction:?}");
+    assert!((needed - 13.8).abs() <= 1e-10, "{needed}");
+    assert!((range[0] + 11.6).abs() <= 1e-10 && (range[1] - 11.6).abs() <= 1e-10, "{range:?}");
+    assert_eq!((at_max, at_min), (&vec!["c2".to_owned()], &vec!["c1".to_owned()]));
 }
 
 #[test]
