@@ -364,3 +364,60 @@ fn the_least_total_answer_is_on_its_vertex_exactly_with_wide_limits() {
         assert!((d.objective - f.iter().sum::<f64>()).abs() <= 1e-9, "{t0:?}");
     }
 }
+
+#[test]
+fn the_single_dof_candidates_move_one_dof_of_one_joint() {
+    // The geometry of the refusal above with a third DOF, joint 2, and its own cable at 300 N:
+    // f = (−30, 660, 300). The candidates are each DOF alone, so the answer is DOF 2 again
+    // (joint 1 only): moving DOF 2 and DOF 3 together would fall shorter per newton (170/√3
+    // ≈ 98 N) but is not a motion of one DOF.
+    let a = 0.02;
+    let j = Mat::from_fn(3, 3, |r, c| match (r, c) {
+        (0, 0) | (0, 1) | (1, 0) | (2, 2) => a,
+        (1, 1) => -a,
+        _ => 0.0,
+    });
+    let f = [-30.0, 660.0, 300.0];
+    let t0: Vec<f64> = (0..3).map(|d| -(0..3).map(|c| j[(c, d)] * f[c]).sum::<f64>()).collect();
+    let groups = [0..2, 2..3];
+    let set = EquilibriumSet::new(j.as_ref(), &t0, &[LIMITS; 3], &groups).unwrap();
+    let why = refusal(&set, &groups);
+    assert_eq!(why.joints, vec![0], "{why}");
+    let NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } = &why.cause else {
+        panic!("{why}")
+    };
+    assert!(
+        direction[0].abs() <= 1e-12 && (direction[1] - 1.0).abs() <= 1e-12 && direction[2] == 0.0,
+        "{direction:?}"
+    );
+    assert!((needed - 13.8).abs() <= 1e-10, "{needed}");
+    assert!((range[0] + 11.6).abs() <= 1e-10 && (range[1] - 11.6).abs() <= 1e-10, "{range:?}");
+    assert_eq!((at_max, at_min), (&vec!["c2".to_owned()], &vec!["c1".to_owned()]));
+}
+
+#[test]
+fn a_candidate_must_fall_short_by_more_than_a_billionth_of_the_largest_limit() {
+    // Limits [1000, 1000.5] N (width floored to 1 N) and the geometry of the refusals above:
+    // f = (1000 − 5e-7, 1000.5 + 6e-7) N is refused (6e-7 of the width out), but no single DOF
+    // and no cable alone falls short by more than 1e-9 × 1000.5 N per newton (DOF 2 alone:
+    // 1.1e-6/√2 ≈ 7.8e-7): the refusal reads the cable farthest out, cable 2, alone. Along
+    // δq = (−1, 1) the load needs 2a f_2, cable 2 gives 2a [1000, 1000.5] N.
+    let a = 0.02;
+    let j = Mat::from_fn(2, 2, |r, c| if r == 1 && c == 1 { -a } else { a });
+    let limits = [1000.0, 1000.5];
+    let f = [1000.0 - 5e-7, 1000.5 + 6e-7];
+    let t0 = [-a * (f[0] + f[1]), -a * (f[0] - f[1])];
+    let groups = [0..2];
+    let set = EquilibriumSet::new(j.as_ref(), &t0, &[limits; 2], &groups).unwrap();
+    let why = refusal(&set, &groups);
+    let NoEquilibriumCause::Limits { direction, needed, range, at_max, at_min } = &why.cause else {
+        panic!("{why}")
+    };
+    assert!(
+        (direction[0] + 1.0).abs() <= 1e-9 && (direction[1] - 1.0).abs() <= 1e-9,
+        "{direction:?}"
+    );
+    assert!((needed - 2.0 * a * f[1]).abs() <= 1e-10, "{needed}");
+    assert!((range[0] - 40.0).abs() <= 1e-10 && (range[1] - 40.02).abs() <= 1e-10, "{range:?}");
+    assert_eq!((at_max, at_min), (&vec!["c2".to_owned()], &vec![]));
+}
