@@ -218,30 +218,29 @@ impl Frame {
     }
 }
 
-/// `Rᵀ M R` (M n × n, R n × p, both row-major) into a new p × p matrix.
+/// `Rᵀ M R` (M n × n symmetric, R n × p, both row-major) into a new p × p matrix, over the rows
+/// of `M` that are not zero only (a decoupled `A_i` has two): `Σ_{i ∈ S} R_iᵀ (M R)_i`.
 pub(crate) fn congruence(m: &[f64], r: &[f64], n: usize, p: usize) -> Vec<f64> {
+    let rows: Vec<usize> =
+        (0..n).filter(|&i| m[i * n..i * n + n].iter().any(|v| *v != 0.0)).collect();
     let mut mr = vec![0.0; n * p];
-    for i in 0..n {
+    for &i in &rows {
         for k in 0..n {
             let v = m[i * n + k];
             if v == 0.0 {
                 continue;
             }
-            for c in 0..p {
-                mr[i * p + c] += v * r[k * p + c];
-            }
+            crate::dense::axpy(v, &r[k * p..k * p + p], &mut mr[i * p..i * p + p]);
         }
     }
     let mut out = vec![0.0; p * p];
-    for i in 0..n {
+    for &i in &rows {
         for a in 0..p {
             let ra = r[i * p + a];
             if ra == 0.0 {
                 continue;
             }
-            for b in 0..p {
-                out[a * p + b] += ra * mr[i * p + b];
-            }
+            crate::dense::axpy(ra, &mr[i * p..i * p + p], &mut out[a * p..a * p + p]);
         }
     }
     crate::dense::symmetrise(&mut out, p);
