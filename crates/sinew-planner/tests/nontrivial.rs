@@ -23,6 +23,7 @@ use sinew_routing::{PatternModel, Routing, RoutingSpec};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome, StiffnessError};
 use sinew_testkit::cdhrm5;
+use sinew_testkit::numeric::grid_points;
 
 /// Whether smaller is better for `objective`.
 fn minimised(objective: Objective) -> bool {
@@ -346,20 +347,6 @@ fn random_search(
         objective.name()
     );
     (checked, best)
-}
-
-/// The points of an `n`-per-axis grid over the cube of half-width `half` around `centre`.
-fn grid_points(centre: &[f64], half: f64, n: usize) -> Vec<Vec<f64>> {
-    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
-    for c in centre {
-        let axis: Vec<f64> =
-            (0..n).map(|i| c - half + 2.0 * half * i as f64 / (n - 1) as f64).collect();
-        points = points
-            .iter()
-            .flat_map(|p| axis.iter().map(move |&a| [p.as_slice(), &[a]].concat()))
-            .collect();
-    }
-    points
 }
 
 /// A brute-force grid against the plan. With levels: the whole cube of the free levels (about
@@ -708,6 +695,37 @@ fn held_levels_are_held_while_the_other_joints_are_optimised() {
     }
 }
 
+/// What a least-tension plan under a binding stiffness floor must beat: the top of every
+/// interval (decoupled; routed, it does not balance the load at this pose), the least common
+/// level that meets the floor, and the random and grid searches; and the least-total tensions
+/// must not meet the floor (else it would not bind).
+fn judge_least_tension_floor(
+    judge: &mut Judge<'_>,
+    model: PatternModel,
+    plan: &Plan,
+    requirements: &Requirements,
+    name: &str,
+    seed: u64,
+    started: Instant,
+) {
+    let objective = Objective::LeastTension;
+    let (top, v_top) = judge.top(objective, requirements);
+    match model {
+        PatternModel::Decoupled => {
+            assert_far_better(name, plan, v_top.expect("levels 1 meet the floor"), "levels 1")
+        }
+        PatternModel::Routed => assert!(top.is_none(), "{name}: levels 1 balance"),
+    }
+    let lowest = judge.lowest(&[]);
+    assert!(judge.value(objective, requirements, &lowest).is_none(), "{name}: least total meets");
+    let uniform = uniform_meeting(judge, requirements);
+    println!("{name}: uniform levels {uniform:?}");
+    let uniform = uniform.expect("a common level meets the floor");
+    assert_far_better(name, plan, uniform, "the least common level");
+    let searched = search(judge, plan, requirements, seed);
+    report(name, plan, &shown(v_top), &searched, started);
+}
+
 /// Least tension with the floor `λ_min(K_fd) ≥ k_min`, 0.8 of the best reachable (at 0.5,
 /// decoupled, the stability margin binds first and the floor is slack): the plan's
 /// total is far below the all-levels-1 point's (decoupled; routed, that point does not
@@ -733,24 +751,9 @@ fn least_tension_meets_a_stiffness_floor_with_equality() {
         check_candidate(&case, arm, &plan, &requirements);
         let reached = least(&plan.k_fd.unwrap());
         assert!(reached <= k_min * (1.0 + 1e-4), "{name}: λ_min {reached}, floor not binding");
-        let (top, v_top) = judge.top(objective, &requirements);
-        match model {
-            PatternModel::Decoupled => {
-                assert_far_better(&name, &plan, v_top.expect("levels 1 meet the floor"), "levels 1")
-            }
-            PatternModel::Routed => assert!(top.is_none(), "{name}: levels 1 balance"),
-        }
-        let lowest = judge.lowest(&[]);
-        assert!(
-            judge.value(objective, &requirements, &lowest).is_none(),
-            "{name}: least total meets"
-        );
-        let uniform = uniform_meeting(&mut judge, &requirements);
-        println!("{name}: λ_min {reached}, uniform levels {uniform:?}");
-        let uniform = uniform.expect("a common level meets the floor");
-        assert_far_better(&name, &plan, uniform, "the least common level");
-        let searched = search(&mut judge, &plan, &requirements, 400 + m as u64);
-        report(&name, &plan, &shown(v_top), &searched, started);
+        println!("{name}: λ_min {reached}");
+        let seed = 400 + m as u64;
+        judge_least_tension_floor(&mut judge, model, &plan, &requirements, &name, seed, started);
     }
 }
 
@@ -779,24 +782,9 @@ fn least_tension_meets_a_desired_stiffness_with_equality() {
         check_candidate(&case, arm, &plan, &requirements);
         let slack = least(&(plan.k_fd.unwrap() - k_des));
         assert!(slack <= 1e-4 * least(&k_des), "{name}: λ_min(K_fd − K_des) {slack}, not binding");
-        let (top, v_top) = judge.top(objective, &requirements);
-        match model {
-            PatternModel::Decoupled => {
-                assert_far_better(&name, &plan, v_top.expect("levels 1 meet K_des"), "levels 1")
-            }
-            PatternModel::Routed => assert!(top.is_none(), "{name}: levels 1 balance"),
-        }
-        let lowest = judge.lowest(&[]);
-        assert!(
-            judge.value(objective, &requirements, &lowest).is_none(),
-            "{name}: least total meets"
-        );
-        let uniform = uniform_meeting(&mut judge, &requirements);
-        println!("{name}: λ_min(K_fd − K_des) {slack}, uniform levels {uniform:?}");
-        let uniform = uniform.expect("a common level meets K_des");
-        assert_far_better(&name, &plan, uniform, "the least common level");
-        let searched = search(&mut judge, &plan, &requirements, 500 + m as u64);
-        report(&name, &plan, &shown(v_top), &searched, started);
+        println!("{name}: λ_min(K_fd − K_des) {slack}");
+        let seed = 500 + m as u64;
+        judge_least_tension_floor(&mut judge, model, &plan, &requirements, &name, seed, started);
     }
 }
 

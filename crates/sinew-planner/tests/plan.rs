@@ -15,6 +15,7 @@ use sinew_routing::{PatternModel, Routing};
 use sinew_statics::{EquilibriumSet, TensionChoice};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData, StiffnessError};
 use sinew_testkit::cdhrm5;
+use sinew_testkit::numeric::grid_points;
 
 /// The objectives a brute force checks (least tension with a stiffness floor separately).
 fn objectives() -> [Objective; 4] {
@@ -107,20 +108,6 @@ fn cdhrm5_case(model: PatternModel) -> Case {
         q: cdhrm5::LOADED_POSE.to_vec(),
         f0: Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0),
     }
-}
-
-/// The points of an `n`-per-axis grid over the cube of half-width `half` around `centre`.
-fn grid_points(centre: &[f64], half: f64, n: usize) -> Vec<Vec<f64>> {
-    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
-    for c in centre {
-        let axis: Vec<f64> =
-            (0..n).map(|i| c - half + 2.0 * half * i as f64 / (n - 1) as f64).collect();
-        points = points
-            .iter()
-            .flat_map(|p| axis.iter().map(move |&a| [p.as_slice(), &[a]].concat()))
-            .collect();
-    }
-    points
 }
 
 /// Tensions within their limits at `lambda`, or None.

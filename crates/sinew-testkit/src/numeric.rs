@@ -98,6 +98,21 @@ pub fn central_difference(q: &[f64], h: f64, mut f: impl FnMut(&[f64]) -> Vec<f6
     out
 }
 
+/// The points of an `n`-per-axis grid (`n ≥ 2`) over the cube of half-width `half` around
+/// `centre`, the last axis varying fastest: brute-force searches over a few coordinates.
+pub fn grid_points(centre: &[f64], half: f64, n: usize) -> Vec<Vec<f64>> {
+    let mut points: Vec<Vec<f64>> = vec![Vec::new()];
+    for c in centre {
+        let axis: Vec<f64> =
+            (0..n).map(|i| c - half + 2.0 * half * i as f64 / (n - 1) as f64).collect();
+        points = points
+            .iter()
+            .flat_map(|p| axis.iter().map(move |&a| [p.as_slice(), &[a]].concat()))
+            .collect();
+    }
+    points
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
