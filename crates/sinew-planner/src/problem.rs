@@ -111,7 +111,8 @@ pub struct Plan {
     /// The objective.
     pub objective: Objective,
     /// Its value at the answer: `uᵀ K_fd u` (N/m), `uᵀ C_x u` (m/N), `λ_min(K_fd)` (N/m),
-    /// `log det K_fd` (ln of (N/m)³) or `Σ f` (N).
+    /// `log det K_fd` (ln of (N/m)³) or `Σ f` (N), as the stiffness pipeline evaluates it at
+    /// `tensions` (as are `k_fd`, `c_x` and `min_eigenvalue`).
     pub value: f64,
     /// The certificate: the true optimum is at most `gap` better than `value` (same unit).
     pub gap: f64,
