@@ -37,6 +37,7 @@
 #![deny(missing_docs)]
 
 mod along;
+mod block_work;
 mod blocks;
 mod bundle;
 #[cfg(test)]

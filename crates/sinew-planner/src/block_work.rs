@@ -1,0 +1,230 @@
+//! The per-block state of an interior-point run (`sdp.rs`) and the kernels that work on
+//! it: the HKM product `sym(A B C)`, the Schur complement's block terms, the step lengths by
+//! Cholesky trials, and the matrix step `ΔF = Σ_a Δx_a F_a`. Module docs of `sdp.rs` for the
+//! math.
+
+use crate::dense::{axpy, cholesky, dot};
+use crate::program::{Block, Duals};
+
+/// Per-block state of a run: the slack, its factor and inverse, the directions, scratch, and
+/// per coefficient `F_a` the rows where it is not zero with the products `F_a Z` and `S⁻¹ F_a`
+/// of the Schur complement (module docs). Allocated once per run; nothing per iteration.
+pub(crate) struct BlockWork {
+    pub(crate) n: usize,
+    pub(crate) s: Vec<f64>,
+    pub(crate) l: Vec<f64>,
+    pub(crate) s_inv: Vec<f64>,
+    pub(crate) ds: Vec<f64>,
+    pub(crate) dz: Vec<f64>,
+    pub(crate) dz_aff: Vec<f64>,
+    pub(crate) ds_aff: Vec<f64>,
+    pub(crate) t1: Vec<f64>,
+    pub(crate) t2: Vec<f64>,
+    pub(crate) product: Vec<f64>,
+    pub(crate) correction: Vec<f64>,
+    pub(crate) trial: Vec<f64>,
+    pub(crate) supports: Vec<Option<Vec<usize>>>,
+    /// Per coefficient: more than half its rows non-zero.
+    pub(crate) dense: Vec<bool>,
+    /// A sparse coefficient's `F_a[S_a, S_a]` (|S_a| × |S_a|).
+    pub(crate) sub: Vec<Vec<f64>>,
+    pub(crate) fz: Vec<Vec<f64>>,
+    pub(crate) sf: Vec<Vec<f64>>,
+}
+
+impl BlockWork {
+    pub(crate) fn new(b: &Block) -> BlockWork {
+        let n = b.n;
+        let z = || vec![0.0; n * n];
+        let supports: Vec<Option<Vec<usize>>> = b
+            .coefficients
+            .iter()
+            .map(|f| {
+                f.as_ref().map(|f| {
+                    (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
+                })
+            })
+            .collect();
+        let dense: Vec<bool> =
+            supports.iter().map(|s| s.as_ref().is_some_and(|rows| 2 * rows.len() > n)).collect();
+        let sub = b
+            .coefficients
+            .iter()
+            .zip(&supports)
+            .zip(&dense)
+            .map(|((f, rows), dense)| match (f, rows) {
+                (Some(f), Some(rows)) if !dense => {
+                    rows.iter().flat_map(|&r| rows.iter().map(move |&c| f[r * n + c])).collect()
+                }
+                _ => Vec::new(),
+            })
+            .collect();
+        let products = || {
+            b.coefficients
+                .iter()
+                .map(|f| if f.is_some() { z() } else { Vec::new() })
+                .collect::<Vec<_>>()
+        };
+        BlockWork {
+            n,
+            s: z(),
+            l: z(),
+            s_inv: z(),
+            ds: z(),
+            dz: z(),
+            dz_aff: z(),
+            ds_aff: z(),
+            t1: z(),
+            t2: z(),
+            product: z(),
+            correction: z(),
+            trial: z(),
+            fz: products(),
+            sf: products(),
+            supports,
+            dense,
+            sub,
+        }
+    }
+}
+
+/// `out = sym(a b c)` (all n × n, `b` and `c` symmetric), `tmp` scratch.
+#[inline(always)]
+pub(crate) fn sym_product(
+    a: &[f64],
+    b: &[f64],
+    c: &[f64],
+    n: usize,
+    tmp: &mut [f64],
+    out: &mut [f64],
+) {
+    crate::dense::multiply_fast(a, b, n, tmp);
+    crate::dense::multiply_fast(tmp, c, n, out);
+    crate::dense::symmetrise(out, n);
+}
+
+/// The largest `α ≤ 1` at 95 % of the way to the boundary of `v + α dv > 0` and of every
+/// `M_j + α dM_j ≻ 0` (Cholesky trials, each stopping at its first non-positive pivot).
+#[inline(always)]
+pub(crate) fn step_length(
+    v: &[f64],
+    dv: &[f64],
+    blocks: &mut [BlockWork],
+    matrices: impl Fn(&BlockWork) -> (&[f64], &[f64]),
+) -> f64 {
+    const FRACTION: f64 = 0.95;
+    let mut alpha = 1.0 / FRACTION;
+    for (a, d) in v.iter().zip(dv) {
+        if *d < 0.0 {
+            alpha = alpha.min(-a / d);
+        }
+    }
+    for _ in 0..60 {
+        let ok = blocks.iter_mut().all(|w| {
+            let mut trial = std::mem::take(&mut w.trial);
+            let (m, dm) = matrices(w);
+            for ((t, a), b) in trial.iter_mut().zip(m).zip(dm) {
+                *t = a + alpha * b;
+            }
+            let ok = cholesky(&mut trial, w.n);
+            w.trial = trial;
+            ok
+        });
+        if ok {
+            return FRACTION * alpha;
+        }
+        alpha *= 0.8;
+    }
+    0.0
+}
+
+/// The Schur complement's block terms `M_ab += tr(F_a Z F_b S⁻¹)`, upper triangle mirrored
+/// (`M` is symmetric). A coefficient is *sparse* when at most half its rows are non-zero (a
+/// decoupled arm's `A_i`: one 2 × 2 joint block); a symmetric `F_a` is then zero outside
+/// `S_a × S_a`, `S_a` its rows, and kept as that sub-block. With `(F_a Z)` on the rows `S_a`:
+///
+/// - one of the pair dense, say `F_d`: `M = Σ_{r ∈ S_s} ⟨(S⁻¹ F_d)_r, (F_s Z)_r⟩`;
+/// - both sparse: `M = Σ_{i ∈ S_a, l ∈ S_b} S⁻¹_li Σ_{k ∈ S_b} (F_a Z)_ik (F_b)_kl`,
+///   `O(|S_a| |S_b|²)`: a handful of products for 2 × 2 joint blocks.
+#[inline(always)]
+pub(crate) fn add_block_schur(
+    b: &Block,
+    z: &[f64],
+    w: &mut BlockWork,
+    k: usize,
+    schur: &mut [f64],
+) {
+    let n = b.n;
+    let s_inv = &w.s_inv;
+    for (a, fa) in b.coefficients.iter().enumerate() {
+        let (Some(fa), Some(rows)) = (fa, &w.supports[a]) else { continue };
+        let (fz, sf) = (&mut w.fz[a], &mut w.sf[a]);
+        if w.dense[a] {
+            // Mostly dense (a routed arm's A_i): two matrix products.
+            crate::dense::multiply_fast(fa, z, n, fz);
+            crate::dense::multiply_fast(s_inv, fa, n, sf);
+            continue;
+        }
+        let (sub, m) = (&w.sub[a], rows.len());
+        for (i, &r) in rows.iter().enumerate() {
+            let out = &mut fz[r * n..r * n + n];
+            out.fill(0.0);
+            for (j, &q) in rows.iter().enumerate() {
+                axpy(sub[i * m + j], &z[q * n..q * n + n], out);
+            }
+        }
+    }
+    for a in 0..k {
+        let Some(rows_a) = &w.supports[a] else { continue };
+        for bb in a..k {
+            let Some(rows_b) = &w.supports[bb] else { continue };
+            let m = match (w.dense[a], w.dense[bb]) {
+                (_, true) => pair_dense(n, rows_a, &w.sf[bb], &w.fz[a]),
+                (true, false) => pair_dense(n, rows_b, &w.sf[a], &w.fz[bb]),
+                (false, false) => {
+                    let (fz, sub, mb) = (&w.fz[a], &w.sub[bb], rows_b.len());
+                    let mut m = 0.0;
+                    for &i in rows_a {
+                        for (l, &ql) in rows_b.iter().enumerate() {
+                            let mut v = 0.0;
+                            for (kk, &qk) in rows_b.iter().enumerate() {
+                                v += fz[i * n + qk] * sub[kk * mb + l];
+                            }
+                            m += s_inv[ql * n + i] * v;
+                        }
+                    }
+                    m
+                }
+            };
+            schur[a * k + bb] += m;
+            if bb != a {
+                schur[bb * k + a] += m;
+            }
+        }
+    }
+}
+
+/// `Σ_{r ∈ rows} ⟨sf_r, fz_r⟩` (rows of n).
+#[inline(always)]
+fn pair_dense(n: usize, rows: &[usize], sf: &[f64], fz: &[f64]) -> f64 {
+    rows.iter().map(|&r| dot(&sf[r * n..r * n + n], &fz[r * n..r * n + n])).sum()
+}
+
+/// Copy each block's `Z` into its `t2` (for the dual step-length trials).
+#[inline(always)]
+pub(crate) fn zs(works: &mut [BlockWork], duals: &Duals) {
+    for (w, z) in works.iter_mut().zip(&duals.z) {
+        w.t2.copy_from_slice(z);
+    }
+}
+
+/// `ΔF = Σ_a dx_a F_a` into `out`.
+#[inline(always)]
+pub(crate) fn matrix_step(b: &Block, dx: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (d, fa) in dx.iter().zip(&b.coefficients) {
+        if let Some(fa) = fa {
+            axpy(*d, fa, out);
+        }
+    }
+}
