@@ -83,17 +83,9 @@ fn bench_plans(c: &mut Criterion) {
         let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
         let mut data = PlannerData::new(&planner);
         let name = if model == PatternModel::Decoupled { "decoupled" } else { "routed" };
-        let steps: Vec<Step> = (0..100)
-            .map(|k| Step {
-                q: (0..10)
-                    .map(|j| {
-                        let omega = 0.5 + 14.5 * j as f64 / 9.0;
-                        cdhrm5::LOADED_POSE[j] + 0.2 * (omega * k as f64 * 1e-3).sin()
-                    })
-                    .collect(),
-                f0: Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0),
-            })
-            .collect();
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        let steps: Vec<Step> =
+            cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
         let objective = Objective::StiffnessAlong(Vector3::y());
         let settings = PlanSettings::default();
         let along = planner

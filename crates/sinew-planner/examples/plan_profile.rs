@@ -53,17 +53,8 @@ fn main() {
     let requirements = Requirements::default();
     if args.get(4).map(String::as_str) == Some("along") {
         // The bench's trajectory: joints at up to 3 rad/s about the loaded pose, 1 kHz.
-        let steps: Vec<Step> = (0..100)
-            .map(|k| Step {
-                q: (0..10)
-                    .map(|j| {
-                        let omega = 0.5 + 14.5 * j as f64 / 9.0;
-                        cdhrm5::LOADED_POSE[j] + 0.2 * (omega * k as f64 * 1e-3).sin()
-                    })
-                    .collect(),
-                f0,
-            })
-            .collect();
+        let steps: Vec<Step> =
+            cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
         let settings = PlanSettings::default();
         let mut warm = 0;
         for _ in 0..plans {

@@ -15,22 +15,11 @@ use sinew_testkit::cdhrm5;
 
 const DT: f64 = 1e-3;
 
-/// `q_j(t) = q0_j + 0.2 sin(ω_j t + φ_j)`, `ω_j` from 0.5 to 15 rad/s: joint speeds up to
-/// 0.1–3 rad/s.
+/// The testkit's swaying trajectory (joint speeds up to 0.1–3 rad/s) with phases `φ_j = 0.3 j`,
+/// under 5 N along y.
 fn trajectory(steps: usize) -> Vec<Step> {
-    let q0 = cdhrm5::LOADED_POSE;
-    (0..steps)
-        .map(|k| {
-            let t = k as f64 * DT;
-            let q = (0..10)
-                .map(|j| {
-                    let omega = 0.5 + 14.5 * j as f64 / 9.0;
-                    q0[j] + 0.2 * (omega * t + 0.3 * j as f64).sin()
-                })
-                .collect();
-            Step { q, f0: Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0) }
-        })
-        .collect()
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    cdhrm5::swaying_poses(steps, DT, 0.3).into_iter().map(|q| Step { q, f0 }).collect()
 }
 
 fn run(

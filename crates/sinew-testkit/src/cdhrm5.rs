@@ -42,6 +42,23 @@ pub const LOADED_POSE: [f64; 10] =
 /// Both cable models, in the order the tests run them.
 pub const MODELS: [PatternModel; 2] = [PatternModel::Decoupled, PatternModel::Routed];
 
+/// The poses of a smooth trajectory about [`LOADED_POSE`] sampled every `dt` seconds:
+/// `q_j(t) = q0_j + 0.2 sin(ω_j t + φ j)`, `ω_j` from 0.5 to 15 rad/s (joint speeds up to
+/// 0.1–3 rad/s). The planner's re-planning bench, profile and tests share it.
+pub fn swaying_poses(steps: usize, dt: f64, phase: f64) -> Vec<Vec<f64>> {
+    (0..steps)
+        .map(|k| {
+            let t = k as f64 * dt;
+            (0..10)
+                .map(|j| {
+                    let omega = 0.5 + 14.5 * j as f64 / 9.0;
+                    LOADED_POSE[j] + 0.2 * (omega * t + phase * j as f64).sin()
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// The workspace root (this crate lives in `crates/sinew-testkit`).
 pub fn workspace_root() -> PathBuf {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
