@@ -3,11 +3,14 @@
 //!
 //! # Warm start
 //! The previous tensions are mapped into the new pose's equilibrium set through the tensions,
-//! `λ' = N'ᵀ(f_prev − f_p')`, so a change of basis of `N` does not matter. When that point is
-//! strictly inside the new constraints (else it is pulled towards the new pose's stable point by
-//! the least fraction that makes it so: the restoration step), the last phase runs from it with
-//! multipliers centred there (`μ` by least squares) and a small iteration cap. Its answer is
-//! accepted only with its certificate within the tolerance; otherwise the step runs cold.
+//! `λ' = N'ᵀ(f_prev − f_p')`, so a change of basis of `N` does not matter. From there, Newton
+//! steps on the previous plan's active rows (module docs of `active.rs`: the smooth objectives
+//! and least tension, with the margin not active and no floor). Where those do not apply or are
+//! not certified: when the point is strictly inside the new constraints (else it is moved by
+//! one least-norm step onto the linearised violated constraints: the restoration step), the
+//! last phase runs from it with multipliers centred there (`μ` by least squares) and a small
+//! iteration cap. An answer is accepted only with its certificate within the tolerance;
+//! otherwise the step runs cold.
 
 use nalgebra::Vector6;
 

@@ -2,6 +2,7 @@
 //! floors, then the objective ([`crate::ipm`]); and warm, from the previous step's tensions
 //! mapped into this pose's set (module docs of `along.rs`).
 
+use crate::active;
 use crate::error::PlanError;
 use crate::frame::Frame;
 use crate::ipm::{Answer, Interior};
@@ -28,8 +29,9 @@ pub(crate) fn cold(
     Ok((answer, rows + stable + floors))
 }
 
-/// The last phase from the mapped previous answer `x` (restored into the interior when it
-/// is not strictly inside), capped at [`WARM_ITERATIONS`]: the answer, or the iterations spent
+/// Newton steps on the mapped previous answer's active set ([`active::warm`]); where they do
+/// not apply or are not certified, the last phase from the mapped previous answer `x`
+/// (restored into the interior when it is not strictly inside), capped at [`WARM_ITERATIONS`]: the answer, or the iterations spent
 /// when it is refused (not restorable, not certified in time).
 pub(crate) fn warm(
     frame: &Frame,
@@ -37,13 +39,18 @@ pub(crate) fn warm(
     requirements: &Requirements,
     settings: &PlanSettings,
     x: Vec<f64>,
+    previous_active: Option<&[usize]>,
 ) -> Result<Answer, usize> {
+    let tried = match active::warm(frame, objective, requirements, settings, &x, previous_active) {
+        Ok(answer) => return Ok(answer),
+        Err(steps) => steps,
+    };
     let mut problem = Interior::new(frame, objective, requirements, settings);
     problem.warm = true;
-    let x = problem.restored(x).ok_or(0_usize)?;
+    let x = problem.restored(x).ok_or(tried)?;
     match problem.optimise(&x, WARM_ITERATIONS) {
-        Ok(answer) => Ok(answer),
-        Err(PlanError::NotConverged { iterations, .. }) => Err(iterations),
-        Err(_) => Err(WARM_ITERATIONS),
+        Ok(answer) => Ok(Answer { iterations: answer.iterations + tried, ..answer }),
+        Err(PlanError::NotConverged { iterations, .. }) => Err(iterations + tried),
+        Err(_) => Err(WARM_ITERATIONS + tried),
     }
 }

@@ -36,6 +36,7 @@
 //! the blocks of each phase), and the bundle method's clarabel allocates each subproblem.
 #![deny(missing_docs)]
 
+mod active;
 mod along;
 mod block_work;
 mod blocks;

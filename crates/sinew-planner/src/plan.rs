@@ -9,6 +9,7 @@ use nalgebra::{Matrix6, Vector6};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 
+use crate::active;
 use crate::bundle::{self, Linear};
 use crate::error::{InputProblem, PlanError};
 use crate::frame::Frame;
@@ -33,12 +34,15 @@ pub struct PlannerData {
     stiffness: ArmStiffnessData,
     /// The last plan's tensions, for a rate limit and a warm start along a trajectory.
     pub(crate) previous: Option<Vec<f64>>,
+    /// The last interior-point plan's active rows, with the number of rows of its frame (the
+    /// warm start's first active set when this frame has as many).
+    active: Option<(usize, Vec<usize>)>,
 }
 
 impl PlannerData {
     /// A workspace for `planner`.
     pub fn new(planner: &Planner) -> PlannerData {
-        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), previous: None }
+        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), previous: None, active: None }
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
@@ -148,9 +152,12 @@ impl Planner {
             Method::InteriorPoint => {
                 let held = held_coordinates(&set, &fixed);
                 let frame = Frame::new(&pencil, &set, &linear.merged(), &held);
+                let rows = frame.rhs.len();
+                let active = data.active.take();
+                let active = active.as_ref().filter(|(n, _)| *n == rows).map(|(_, a)| &a[..]);
                 let attempt = previous.as_ref().map(|f| {
                     let x = frame.x_of(&set.coordinates(f));
-                    interior::warm(&frame, objective, requirements, settings, x)
+                    interior::warm(&frame, objective, requirements, settings, x, active)
                 });
                 let limited = rate.is_some() && previous.is_some();
                 let cold = |data: &mut PlannerData| {
@@ -172,6 +179,7 @@ impl Planner {
                     }
                     None => cold(data)?,
                 };
+                data.active = Some((rows, active::active_rows(&frame, &answer.x)));
                 (frame.lambda(&answer.x), answer.upper, before + answer.iterations)
             }
             Method::Bundle => {

@@ -38,9 +38,14 @@ fn run(
 #[test]
 fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
     let steps = trajectory(1000);
-    for (model, objective) in [
-        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y())),
-        (PatternModel::Routed, Objective::MinStiffness),
+    // The Newton steps on the previous active set (smooth objectives, least tension with the
+    // margin not active) take one or two evaluations where the interior-point method's warm
+    // start takes four or more: `Some(2)` bounds the median for those.
+    for (model, objective, newton) in [
+        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y()), Some(2)),
+        (PatternModel::Routed, Objective::Volume, Some(2)),
+        (PatternModel::Routed, Objective::LeastTension, Some(2)),
+        (PatternModel::Routed, Objective::MinStiffness, None),
     ] {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
         let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
@@ -88,6 +93,9 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
         );
         // The warm path is the rule along a smooth trajectory, not the exception.
         assert!(warm >= 900, "only {warm} warm steps");
+        if let Some(most) = newton {
+            assert!(median <= most, "median warm iterations {median}: not the Newton steps");
+        }
         // Deterministic: a second run gives the same bits.
         let again = run(&planner, &steps, objective, None);
         for (a, b) in along.iter().zip(&again) {
