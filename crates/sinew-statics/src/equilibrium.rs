@@ -5,7 +5,7 @@
 //! # Math
 //! The cables balance the joints when `−J_cᵀ f = T0` (eq. 5–6), `J_c` the m × dof cable
 //! Jacobian. With the singular value decomposition `J_c = U Σ Vᵀ` and `r` its numerical rank
-//! ([`SET_RANK_TOLERANCE`]):
+//! ([`crate::SET_RANK_TOLERANCE`]):
 //!
 //! ```text
 //! f_p = −U_r Σ_r⁻¹ V_rᵀ T0        (the minimum-norm balancing tensions, f_p ⊥ N)
@@ -21,11 +21,13 @@
 //! another joint, `N` has one column per joint and the polytope is the box of the per-joint
 //! intervals of [`crate::tension_interval`].
 //!
-//! The SVD is taken block by block: the DOFs linked by the cables that move them (non-zero
+//! The set is built block by block: the DOFs linked by the cables that move them (non-zero
 //! entries of `J_c`) fall into independent blocks — one per joint in the decoupled model, one
 //! for the whole arm when every cable runs from the base — and `N` is block diagonal over them
 //! (one column per joint with three cables on each universal joint of a decoupled arm), which
-//! keeps the policies' programs sparse.
+//! keeps the policies' programs sparse. A universal joint driven by three cables has its share
+//! in closed form (one normalised cross product, no SVD); any other block by its SVD
+//! (module docs of `set_block.rs`).
 //!
 //! Force closure — some strictly positive `f` in `null(J_cᵀ)`, so that any torque can be held
 //! with high enough tensions — is a property of the pose and the routing
@@ -36,9 +38,7 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 
 use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
-
-/// A singular value of `J_c` below this fraction of the largest counts as zero.
-pub const SET_RANK_TOLERANCE: f64 = 1e-10;
+use crate::set_block::{Block, BlockSet};
 
 /// The relative equilibrium residual `|T0 + J_cᵀ f| / |T0|` accepted as balance.
 pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-9;
@@ -49,7 +49,8 @@ pub(crate) const NAMED_SHARE: f64 = 0.1;
 
 /// The equilibrium set `f = f_p + N λ` of a cable set under a load, and its tension limits.
 ///
-/// Built per configuration by [`EquilibriumSet::new`] (it allocates: an SVD of `J_c`); the
+/// Built per configuration by [`EquilibriumSet::new`] (it allocates; an SVD of each block of
+/// `J_c` that is not a three-cable joint); the
 /// tension policies of [`crate::TensionPolicy`] choose a point of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EquilibriumSet {
@@ -57,20 +58,9 @@ pub struct EquilibriumSet {
     null: Mat<f64>,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    /// The independent blocks of `J_c` and their SVDs (for `J_c⁺`).
+    /// The independent blocks of `J_c` with `J_c⁺` on each.
     blocks: Vec<Block>,
     dof: usize,
-}
-
-/// An independent block of `J_c`: cables that move only these DOFs, DOFs that only these
-/// cables move. `U_r` (cables × r), `Σ_r` (r), `V_r` (DOFs × r): `J_c⁺ = V_r Σ_r⁻¹ U_rᵀ` on it.
-#[derive(Debug, Clone, PartialEq)]
-struct Block {
-    cables: Vec<usize>,
-    dofs: Vec<usize>,
-    u_range: Mat<f64>,
-    singular: Vec<f64>,
-    v_range: Mat<f64>,
 }
 
 /// The independent blocks of `J_c` (m × dof): the connected components of the DOFs linked by
@@ -156,33 +146,15 @@ impl EquilibriumSet {
             if cables.is_empty() {
                 continue; // DOFs no cable moves: the residual check below names them.
             }
-            let sub = Mat::from_fn(cables.len(), dofs.len(), |r, c| jacobian[(cables[r], dofs[c])]);
-            let svd = sub.svd().map_err(|_| StaticsError::Numerical { what: "SVD of J_c" })?;
-            let s = svd.S().column_vector();
-            let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
-            let rank = (0..s.nrows()).filter(|&i| s[i] > SET_RANK_TOLERANCE * largest).count();
-            let (u, v) = (svd.U(), svd.V());
-            let singular: Vec<f64> = (0..rank).map(|i| s[i]).collect();
-            // f_p = −U_r Σ_r⁻¹ V_rᵀ T0 on the block.
-            let y: Vec<f64> = (0..rank)
-                .map(|i| {
-                    (0..dofs.len()).map(|d| v[(d, i)] * t0[dofs[d]]).sum::<f64>() / singular[i]
-                })
-                .collect();
-            for (r, &c) in cables.iter().enumerate() {
-                particular[c] = -(0..rank).map(|i| u[(r, i)] * y[i]).sum::<f64>();
+            let set = BlockSet::new(jacobian, cables, dofs, t0, groups)?;
+            let cables = &set.block.cables;
+            for (&c, &f) in cables.iter().zip(&set.particular) {
+                particular[c] = f;
             }
-            for i in rank..cables.len() {
-                null_columns
-                    .push(cables.iter().enumerate().map(|(r, &c)| (c, u[(r, i)])).collect());
+            for column in &set.null_columns {
+                null_columns.push(cables.iter().copied().zip(column.iter().copied()).collect());
             }
-            blocks.push(Block {
-                u_range: u.subcols(0, rank).to_owned(),
-                v_range: v.subcols(0, rank).to_owned(),
-                singular,
-                cables,
-                dofs,
-            });
+            blocks.push(set.block);
         }
         let mut null = Mat::zeros(m, null_columns.len());
         for (i, column) in null_columns.iter().enumerate() {
@@ -285,19 +257,13 @@ impl EquilibriumSet {
     pub fn joint_motion(&self, w: &[f64]) -> Vec<f64> {
         let mut motion = vec![0.0; self.dof];
         for b in &self.blocks {
-            let y: Vec<f64> = (0..b.singular.len())
-                .map(|i| {
-                    let dot: f64 = b
-                        .cables
-                        .iter()
-                        .enumerate()
-                        .map(|(r, &c)| b.u_range[(r, i)] * w.get(c).copied().unwrap_or(0.0))
-                        .sum();
-                    dot / b.singular[i]
-                })
-                .collect();
             for (k, &d) in b.dofs.iter().enumerate() {
-                motion[d] = (0..y.len()).map(|i| b.v_range[(k, i)] * y[i]).sum();
+                motion[d] = b
+                    .cables
+                    .iter()
+                    .enumerate()
+                    .map(|(r, &c)| b.pseudo_inverse[(k, r)] * w.get(c).copied().unwrap_or(0.0))
+                    .sum();
             }
         }
         motion
@@ -308,19 +274,13 @@ impl EquilibriumSet {
     pub(crate) fn cable_motion(&self, dq: &[f64]) -> Vec<f64> {
         let mut lengths = vec![0.0; self.cable_count()];
         for b in &self.blocks {
-            let y: Vec<f64> = (0..b.singular.len())
-                .map(|i| {
-                    let dot: f64 = b
-                        .dofs
-                        .iter()
-                        .enumerate()
-                        .map(|(k, &d)| b.v_range[(k, i)] * dq.get(d).copied().unwrap_or(0.0))
-                        .sum();
-                    b.singular[i] * dot
-                })
-                .collect();
             for (r, &c) in b.cables.iter().enumerate() {
-                lengths[c] = (0..y.len()).map(|i| b.u_range[(r, i)] * y[i]).sum();
+                lengths[c] = b
+                    .dofs
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &d)| b.range[(r, k)] * dq.get(d).copied().unwrap_or(0.0))
+                    .sum();
             }
         }
         lengths

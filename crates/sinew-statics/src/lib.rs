@@ -63,11 +63,13 @@ mod joint_end;
 mod levels;
 mod policy;
 mod refusal;
+mod set_block;
+mod three_cable;
 
 pub use arm::{ArmStatics, ArmStaticsData};
 pub use choice::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
-pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet, SET_RANK_TOLERANCE};
+pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet};
 pub use error::{NoEquilibrium, NoEquilibriumCause, SolverStop, StaticsError, UnsupportedRouting};
 pub use interval::{
     FORCE_CLOSURE_TOLERANCE, JOINT_RANK_TOLERANCE, TensionInterval, TensionLimits,
@@ -78,6 +80,7 @@ pub use joint_end::{
 };
 pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
 pub use refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
+pub use set_block::SET_RANK_TOLERANCE;
 
 use faer::MatRef;
 

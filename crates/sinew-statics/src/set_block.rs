@@ -1,0 +1,295 @@
+//! One independent block of `J_c` in the equilibrium set ([`crate::EquilibriumSet`]): its
+//! minimum-norm balancing tensions, the columns of `null(J_cᵀ)` it holds, and `J_c⁺` on it.
+//!
+//! # Math
+//! A block is a set of cables and the DOFs they move (cables × DOFs submatrix `J` of `J_c`).
+//!
+//! - **A universal joint driven by three cables** (every joint of a decoupled arm), `J` 3 × 2
+//!   with columns `a`, `b`: in closed form, no SVD. `null(Jᵀ)` is spanned by
+//!   `n = a × b / |a × b|`, oriented so that `Σ n > 0` (all positive when the joint is in force
+//!   closure). `(Jᵀ)⁺ = (I − n nᵀ) E`, `E` the inverse of the 2 × 2 minor of `Jᵀ` on the two
+//!   cables other than the one of `a × b`'s largest component (whose determinant that component
+//!   is), placed on their rows; then `f_p = −(Jᵀ)⁺ t` and `J⁺ = ((Jᵀ)⁺)ᵀ`, to rounding times
+//!   the block's condition number (not its square, as the normal equations would give). The
+//!   product of the singular values is `|a × b|` and the largest is the root of `JᵀJ`'s larger
+//!   eigenvalue: the closed form is taken when `σ₂ > 10⁻⁶ σ₁`, the SVD below (where the rank
+//!   test of [`SET_RANK_TOLERANCE`] decides).
+//! - **Otherwise** the SVD `J = U Σ Vᵀ`, with `r` its numerical rank: `f_p = −U_r Σ_r⁻¹ V_rᵀ t`,
+//!   `N = U[:, r..]`, `J⁺ = V_r Σ_r⁻¹ U_rᵀ`, and the range of `J` as `U_r Σ_r V_rᵀ`.
+
+use std::ops::Range;
+
+use faer::{Mat, MatRef};
+
+use crate::error::StaticsError;
+use crate::three_cable::{three_cable_joint, triangular};
+
+/// A singular value of `J_c` below this fraction of the largest counts as zero.
+pub const SET_RANK_TOLERANCE: f64 = 1e-10;
+
+/// An independent block of `J_c`: cables that move only these DOFs, DOFs that only these
+/// cables move, with `J⁺` (DOFs × cables) and `J` on its numerical range (cables × DOFs).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Block {
+    pub(crate) cables: Vec<usize>,
+    pub(crate) dofs: Vec<usize>,
+    pub(crate) pseudo_inverse: Mat<f64>,
+    pub(crate) range: Mat<f64>,
+}
+
+/// A block's share of the equilibrium set: the block, `f_p` on its cables (in the block's
+/// order), and its columns of `N` (each over the block's cables).
+pub(crate) struct BlockSet {
+    pub(crate) block: Block,
+    pub(crate) particular: Vec<f64>,
+    pub(crate) null_columns: Vec<Vec<f64>>,
+}
+
+impl BlockSet {
+    /// The block of `cables` and `dofs` of `jacobian` (m × dof) under the torques `t0` (dof);
+    /// `groups` are the arm's joints as DOF ranges.
+    ///
+    /// # Errors
+    /// [`StaticsError::Numerical`] when the SVD fails.
+    pub(crate) fn new(
+        jacobian: MatRef<'_, f64>,
+        cables: Vec<usize>,
+        dofs: Vec<usize>,
+        t0: &[f64],
+        groups: &[Range<usize>],
+    ) -> Result<BlockSet, StaticsError> {
+        let sub = Mat::from_fn(cables.len(), dofs.len(), |r, c| jacobian[(cables[r], dofs[c])]);
+        let t: Vec<f64> = dofs.iter().map(|&d| t0[d]).collect();
+        let closed = match three_cable_joint(sub.as_ref(), &t) {
+            Some((particular, null, pseudo_inverse)) => {
+                Some((particular, vec![null], pseudo_inverse))
+            }
+            None => triangular(sub.as_ref(), &dofs, groups, &t),
+        };
+        if let Some((particular, null_columns, pseudo_inverse)) = closed {
+            return Ok(BlockSet {
+                block: Block { cables, dofs, pseudo_inverse, range: sub },
+                particular,
+                null_columns,
+            });
+        }
+        BlockSet::by_svd(sub, cables, dofs, &t)
+    }
+
+    /// The block by the SVD of its submatrix `sub` of `J_c` (module docs), `t` the torques on
+    /// its DOFs.
+    fn by_svd(
+        sub: Mat<f64>,
+        cables: Vec<usize>,
+        dofs: Vec<usize>,
+        t: &[f64],
+    ) -> Result<BlockSet, StaticsError> {
+        let svd = sub.svd().map_err(|_| StaticsError::Numerical { what: "SVD of J_c" })?;
+        let s = svd.S().column_vector();
+        let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
+        let rank = (0..s.nrows()).filter(|&i| s[i] > SET_RANK_TOLERANCE * largest).count();
+        let (u, v) = (svd.U(), svd.V());
+        // f_p = −U_r Σ_r⁻¹ V_rᵀ t on the block.
+        let y: Vec<f64> = (0..rank)
+            .map(|i| (0..dofs.len()).map(|d| v[(d, i)] * t[d]).sum::<f64>() / s[i])
+            .collect();
+        let particular =
+            (0..cables.len()).map(|r| -(0..rank).map(|i| u[(r, i)] * y[i]).sum::<f64>()).collect();
+        let null_columns =
+            (rank..cables.len()).map(|i| (0..cables.len()).map(|r| u[(r, i)]).collect()).collect();
+        let pseudo_inverse = Mat::from_fn(dofs.len(), cables.len(), |d, r| {
+            (0..rank).map(|i| v[(d, i)] * u[(r, i)] / s[i]).sum()
+        });
+        let range = Mat::from_fn(cables.len(), dofs.len(), |r, d| {
+            (0..rank).map(|i| u[(r, i)] * s[i] * v[(d, i)]).sum()
+        });
+        Ok(BlockSet {
+            block: Block { cables, dofs, pseudo_inverse, range },
+            particular,
+            null_columns,
+        })
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    /// A 3 × 2 block `[a b]` with `b = a + δ·e`: `δ` sets its conditioning.
+    fn block(a: [f64; 3], e: [f64; 3], delta: f64) -> Mat<f64> {
+        Mat::from_fn(3, 2, |r, c| if c == 0 { a[r] } else { a[r] + delta * e[r] })
+    }
+
+    #[test]
+    fn the_closed_form_of_a_three_cable_joint_is_the_svd_s_answer() {
+        let t = [0.7, -1.3];
+        let cases = [
+            ([0.011, -0.004, -0.007], [0.3, 0.9, -1.2], 1.0),
+            ([-0.02, 0.013, 0.006], [1.0, 0.2, 0.4], 0.01),
+            ([0.5, 0.1, -0.6], [0.0, 1.0, -1.0], 1e-4),
+            ([0.0, 0.0, 0.8], [1.0, -1.0, 0.0], 1e-5),
+        ];
+        for (a, e, delta) in cases {
+            let j = block(a, e, delta);
+            let (fp, n, pinv) = three_cable_joint(j.as_ref(), &t).expect("closed form");
+            let svd = BlockSet::by_svd(j.clone(), vec![0, 1, 2], vec![0, 1], &t).unwrap();
+            let s = j.svd().unwrap();
+            let s = s.S().column_vector();
+            // Both are exact to rounding times the condition number.
+            let tolerance = 64.0 * f64::EPSILON * s[0] / s[1];
+            let scale = fp.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            for (x, y) in fp.iter().zip(&svd.particular) {
+                assert!(
+                    (x - y).abs() <= tolerance * scale,
+                    "f_p {fp:?} against {:?}",
+                    svd.particular
+                );
+            }
+            // Jᵀ f_p = −t.
+            for d in 0..2 {
+                let v: f64 = (0..3).map(|r| j[(r, d)] * fp[r]).sum();
+                assert!((v + t[d]).abs() <= tolerance * scale * s[0], "Jᵀf_p[{d}] = {v}");
+            }
+            // N up to its sign, which the closed form fixes: Σ n > 0.
+            let other = &svd.null_columns[0];
+            let dot: f64 = n.iter().zip(other).map(|(x, y)| x * y).sum();
+            let sign = if dot < 0.0 { -1.0 } else { 1.0 };
+            for (x, y) in n.iter().zip(other) {
+                assert!((x - sign * y).abs() <= tolerance, "n {n:?} against {other:?}");
+            }
+            assert!(n.iter().sum::<f64>() > 0.0);
+            // J⁺ J = I, and against the SVD's.
+            let size = pinv.norm_max();
+            for d in 0..2 {
+                for e in 0..2 {
+                    let v: f64 = (0..3).map(|r| pinv[(d, r)] * j[(r, e)]).sum();
+                    let expected = if d == e { 1.0 } else { 0.0 };
+                    assert!((v - expected).abs() <= tolerance, "J⁺J[{d},{e}] = {v}");
+                }
+                for r in 0..3 {
+                    let (x, y) = (pinv[(d, r)], svd.block.pseudo_inverse[(d, r)]);
+                    assert!((x - y).abs() <= tolerance * size, "J⁺ {x} against {y}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_joint_near_rank_one_goes_to_the_svd() {
+        // b = a + δ e with e ⊥ a, |a| = |e| = 1: σ₂/σ₁ ≈ δ/2.
+        let (a, e) = ([0.0, 0.6, 0.8], [1.0, 0.0, 0.0]);
+        let t = [0.0, 0.0];
+        assert!(three_cable_joint(block(a, e, 1e-5).as_ref(), &t).is_some());
+        assert!(three_cable_joint(block(a, e, 1e-7).as_ref(), &t).is_none());
+        assert!(three_cable_joint(block(a, e, 0.0).as_ref(), &t).is_none());
+        // Another shape is not a three-cable joint.
+        assert!(three_cable_joint(Mat::<f64>::zeros(4, 2).as_ref(), &[0.0, 0.0]).is_none());
+        // A rank-one block: two null columns, by the SVD.
+        let set = BlockSet::new(
+            block(a, e, 0.0).as_ref(),
+            vec![0, 1, 2],
+            vec![0, 1],
+            &t,
+            &[Range { start: 0, end: 2 }],
+        )
+        .unwrap();
+        assert_eq!(set.null_columns.len(), 2);
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod triangular_tests {
+    use super::*;
+
+    /// A routed block of `joints` joints: three cables end at each joint and cross every joint
+    /// before it, with entries from a fixed pseudo-random sequence.
+    fn routed(joints: usize, seed: u64) -> Mat<f64> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        Mat::from_fn(
+            3 * joints,
+            2 * joints,
+            |c, d| if d / 2 <= c / 3 { 0.02 * next() } else { 0.0 },
+        )
+    }
+
+    #[test]
+    fn the_routed_closed_form_is_the_svd_s_set_with_a_block_triangular_basis() {
+        for (joints, seed) in [(1, 3), (2, 5), (5, 7), (8, 11)] {
+            let j = routed(joints, seed);
+            let (m, dof) = (3 * joints, 2 * joints);
+            let dofs: Vec<usize> = (0..dof).collect();
+            let groups: Vec<Range<usize>> = (0..joints).map(|l| 2 * l..2 * l + 2).collect();
+            let t: Vec<f64> = (0..dof).map(|d| 0.3 * (d as f64 + 1.0).sin()).collect();
+            let (fp, null, pinv) =
+                triangular(j.as_ref(), &dofs, &groups, &t).expect("the routed shape");
+            let svd = BlockSet::by_svd(j.clone(), (0..m).collect(), dofs.clone(), &t).unwrap();
+            let s = j.svd().unwrap();
+            let s = s.S().column_vector();
+            let tolerance = 256.0 * f64::EPSILON * s[0] / s[dof - 1];
+            let size = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+            let scale = size(&fp);
+            for (x, y) in fp.iter().zip(&svd.particular) {
+                assert!((x - y).abs() <= tolerance * scale, "{joints} joints: f_p {x} against {y}");
+            }
+            // The same subspace: N Nᵀ equal; N orthonormal; column l on joints 0..=l, its own
+            // joint's cables summing positive.
+            assert_eq!(null.len(), svd.null_columns.len());
+            for a in 0..m {
+                for b in 0..m {
+                    let p: f64 = null.iter().map(|u| u[a] * u[b]).sum();
+                    let q: f64 = svd.null_columns.iter().map(|u| u[a] * u[b]).sum();
+                    assert!((p - q).abs() <= tolerance, "N Nᵀ[{a},{b}]: {p} against {q}");
+                }
+            }
+            for (l, u) in null.iter().enumerate() {
+                for (l2, w) in null.iter().enumerate() {
+                    let dot: f64 = u.iter().zip(w).map(|(x, y)| x * y).sum();
+                    let expected = if l == l2 { 1.0 } else { 0.0 };
+                    assert!((dot - expected).abs() <= 1e-14, "column {l}·{l2} = {dot}");
+                }
+                assert!(u[3 * (l + 1)..].iter().all(|v| *v == 0.0), "column {l} beyond joint {l}");
+                assert!(u[3 * l..3 * l + 3].iter().sum::<f64>() > 0.0);
+            }
+            let largest = pinv.norm_max();
+            for d in 0..dof {
+                for c in 0..m {
+                    let (x, y) = (pinv[(d, c)], svd.block.pseudo_inverse[(d, c)]);
+                    assert!((x - y).abs() <= tolerance * largest, "J⁺[{d},{c}] {x} against {y}");
+                }
+            }
+            // Through BlockSet::new: a closed form is the one taken (one joint's own, for one).
+            let set = BlockSet::new(j.as_ref(), (0..m).collect(), dofs, &t, &groups).unwrap();
+            if joints > 1 {
+                assert_eq!(set.particular, fp);
+            }
+        }
+    }
+
+    #[test]
+    fn other_shapes_go_to_the_svd() {
+        let j = routed(3, 13);
+        let dofs: Vec<usize> = (0..6).collect();
+        let t = vec![0.1; 6];
+        let joints: Vec<Range<usize>> = (0..3).map(|l| 2 * l..2 * l + 2).collect();
+        let tri = |j: MatRef<'_, f64>, groups: &[Range<usize>]| triangular(j, &dofs, groups, &t);
+        assert!(tri(j.as_ref(), &joints).is_some());
+        // Joints of three DOFs are not universal joints.
+        assert!(tri(j.as_ref(), &[0..3, 3..6]).is_none());
+        // Four cables at the tip: not three per joint.
+        let four = Mat::from_fn(10, 6, |c, d| if c < 9 { j[(c, d)] } else { 0.01 * (d as f64) });
+        let dofs4: Vec<usize> = (0..6).collect();
+        assert!(triangular(four.as_ref(), &dofs4, &joints, &t).is_none());
+        // A joint whose own block has rank one.
+        let mut flat = j.clone();
+        for c in 3..6 {
+            flat[(c, 3)] = flat[(c, 2)];
+        }
+        assert!(tri(flat.as_ref(), &joints).is_none());
+    }
+}

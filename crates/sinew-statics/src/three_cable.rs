@@ -1,0 +1,179 @@
+//! The equilibrium set's closed forms for universal joints driven by three cables each (module
+//! docs of `set_block.rs` for the single joint): no SVD where the routing has this shape.
+//!
+//! # Math
+//! **One joint**, `J` 3 × 2 with columns `a`, `b`: `null(Jᵀ)` is spanned by
+//! `n = a × b / |a × b|` (oriented so that `Σ n > 0`), and `(Jᵀ)⁺ = (I − n nᵀ) E`, `E` the
+//! inverse of the 2 × 2 minor of `Jᵀ` on the two cables other than the one of `a × b`'s
+//! largest component, placed on their rows.
+//!
+//! **A routed arm**: every cable ends at one joint and crosses only joints before it, so with
+//! the cables grouped by the joint they end at, `J_cᵀ` is block upper triangular with the
+//! joints' own 3 × 2 blocks `B_l` on its diagonal. `J_cᵀ f = r` is solved from the tip:
+//! `f_l = (B_lᵀ)⁺ (r_l − Σ_{l' > l} B_{l'l}ᵀ f_{l'})`. The vector `v_j` with `n_j` on joint
+//! `j`'s cables, zero beyond, and the back-substitution of `r = 0` before, lies in
+//! `null(J_cᵀ)`; the `v_j` are independent (triangular) and there are `m − dof` of them, so
+//! Gram–Schmidt (twice) in the order `j = 0, 1, …` gives an orthonormal `N` whose column `j`
+//! lives on the cables of joints `0..=j`: the block-triangular basis built from the tip. Then
+//! `f_p = f* − N Nᵀ f*` for the back-substituted `f*` of `r = −t`, and `(J_cᵀ)⁺` the same
+//! projection of the back-substituted unit torques. Taken when every joint's own block passes
+//! the single joint's conditioning test; anything else goes to the SVD.
+
+use std::ops::Range;
+
+use faer::{Mat, MatRef};
+
+/// The closed form of a three-cable joint is taken when its smallest singular value is at least
+/// this fraction of its largest.
+const CLOSED_FORM_CONDITION: f64 = 1e-6;
+
+/// `n` and `(Jᵀ)⁺` (3 × 2, rows by cable) of a 3 × 2 block, or `None` for a block too close to
+/// rank 1 (module docs).
+fn joint_pieces(j: MatRef<'_, f64>) -> Option<([f64; 3], [[f64; 2]; 3])> {
+    let a = [j[(0, 0)], j[(1, 0)], j[(2, 0)]];
+    let b = [j[(0, 1)], j[(1, 1)], j[(2, 1)]];
+    let dot = |u: &[f64; 3], w: &[f64; 3]| u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+    let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let (aa, ab, bb) = (dot(&a, &a), dot(&a, &b), dot(&b, &b));
+    let area = dot(&cross, &cross).sqrt();
+    // σ₁² is the larger eigenvalue of JᵀJ; σ₁ σ₂ = |a × b|.
+    let largest = (0.5 * (aa + bb + ((aa - bb).powi(2) + 4.0 * ab * ab).sqrt())).sqrt();
+    if !(area.is_finite() && largest > 0.0 && area / largest > CLOSED_FORM_CONDITION * largest) {
+        return None;
+    }
+    let sign = if cross.iter().sum::<f64>() < 0.0 { -1.0 } else { 1.0 };
+    let n: [f64; 3] = std::array::from_fn(|r| sign * cross[r] / area);
+    let r = (0..3).fold(0, |best, i| if cross[i].abs() > cross[best].abs() { i } else { best });
+    let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+    // Jᵀ on cables (p, q): [[a_p, a_q], [b_p, b_q]], determinant (a × b)_r.
+    let det = cross[r];
+    let mut e = [[0.0; 2]; 3];
+    e[p] = [b[q] / det, -a[q] / det];
+    e[q] = [-b[p] / det, a[p] / det];
+    let mut inverse = [[0.0; 2]; 3];
+    for col in 0..2 {
+        let along: f64 = (0..3).map(|c| n[c] * e[c][col]).sum();
+        for c in 0..3 {
+            inverse[c][col] = e[c][col] - n[c] * along;
+        }
+    }
+    Some((n, inverse))
+}
+
+/// The closed form of a 3 × 2 block: `(f_p, n, J⁺)` under the torques `t`, or `None` for
+/// another shape or a block too close to rank 1.
+pub(crate) fn three_cable_joint(
+    j: MatRef<'_, f64>,
+    t: &[f64],
+) -> Option<(Vec<f64>, Vec<f64>, Mat<f64>)> {
+    if j.nrows() != 3 || j.ncols() != 2 {
+        return None;
+    }
+    let (n, inverse) = joint_pieces(j)?;
+    let particular = (0..3).map(|c| -(inverse[c][0] * t[0] + inverse[c][1] * t[1])).collect();
+    Some((particular, n.to_vec(), Mat::from_fn(2, 3, |d, c| inverse[c][d])))
+}
+
+/// The routed arm's block-triangular closed form (module docs) of the block `j` (cables ×
+/// DOFs, the block's `dofs` global) under the torques `t` (on the block's DOFs), with the arm's
+/// joints `groups`: `(f_p, N's columns, J⁺)`, or `None` when the block does not have the shape
+/// (two DOFs per joint, three cables ending at each) or a joint's own block is too close to
+/// rank 1.
+#[allow(clippy::type_complexity)]
+pub(crate) fn triangular(
+    j: MatRef<'_, f64>,
+    dofs: &[usize],
+    groups: &[Range<usize>],
+    t: &[f64],
+) -> Option<(Vec<f64>, Vec<Vec<f64>>, Mat<f64>)> {
+    let (m, dof) = (j.nrows(), j.ncols());
+    // The block's joints: consecutive pairs of its DOFs, each a whole joint of the arm.
+    if dof % 2 != 0 || m != 3 * dof / 2 {
+        return None;
+    }
+    let joints = dof / 2;
+    for l in 0..joints {
+        let g = groups.iter().find(|g| g.start == dofs[2 * l])?;
+        if g.len() != 2 || dofs[2 * l + 1] != g.start + 1 {
+            return None;
+        }
+    }
+    // Each cable's joint: that of its last non-zero DOF; three per joint.
+    let mut ends: Vec<Vec<usize>> = vec![Vec::new(); joints];
+    for c in 0..m {
+        let last = (0..dof).rev().find(|&d| j[(c, d)] != 0.0)?;
+        ends[last / 2].push(c);
+    }
+    if ends.iter().any(|e| e.len() != 3) {
+        return None;
+    }
+    let mut pieces = Vec::with_capacity(joints);
+    for (l, cables) in ends.iter().enumerate() {
+        let own = Mat::from_fn(3, 2, |r, d| j[(cables[r], 2 * l + d)]);
+        pieces.push(joint_pieces(own.as_ref())?);
+    }
+    // J_cᵀ f = r on the joints before `from`, from the tip down, with f already set on the
+    // cables of joints `from..=upto` (and zero beyond).
+    let solve = |r: &[f64], from: usize, upto: usize, f: &mut [f64]| {
+        for l in (0..from).rev() {
+            let mut rest = [r[2 * l], r[2 * l + 1]];
+            for cables in &ends[l + 1..=upto] {
+                for &c in cables {
+                    rest[0] -= j[(c, 2 * l)] * f[c];
+                    rest[1] -= j[(c, 2 * l + 1)] * f[c];
+                }
+            }
+            let inverse = &pieces[l].1;
+            for (row, &c) in ends[l].iter().enumerate() {
+                f[c] = inverse[row][0] * rest[0] + inverse[row][1] * rest[1];
+            }
+        }
+    };
+    let zero = vec![0.0; dof];
+    let mut null: Vec<Vec<f64>> = Vec::with_capacity(joints);
+    for top in 0..joints {
+        // n_top on joint top's cables; the joints before balance its torques on them.
+        let mut v = vec![0.0; m];
+        for (row, &c) in ends[top].iter().enumerate() {
+            v[c] = pieces[top].0[row];
+        }
+        solve(&zero, top, top, &mut v);
+        // Gram–Schmidt twice against the columns before.
+        for _ in 0..2 {
+            for u in &null {
+                let along: f64 = u.iter().zip(&v).map(|(a, b)| a * b).sum();
+                v.iter_mut().zip(u).for_each(|(x, y)| *x -= along * y);
+            }
+        }
+        let size = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !(size > 0.0 && size.is_finite()) {
+            return None;
+        }
+        v.iter_mut().for_each(|x| *x /= size);
+        null.push(v);
+    }
+    let project = |f: &mut [f64]| {
+        for u in &null {
+            let along: f64 = u.iter().zip(f.iter()).map(|(a, b)| a * b).sum();
+            f.iter_mut().zip(u).for_each(|(x, y)| *x -= along * y);
+        }
+    };
+    let mut particular = vec![0.0; m];
+    let minus_t: Vec<f64> = t.iter().map(|v| -v).collect();
+    solve(&minus_t, joints, joints - 1, &mut particular);
+    project(&mut particular);
+    let mut pseudo_inverse = Mat::zeros(dof, m);
+    let mut unit = vec![0.0; dof];
+    let mut column = vec![0.0; m];
+    for d in 0..dof {
+        unit.fill(0.0);
+        unit[d] = 1.0;
+        column.fill(0.0);
+        solve(&unit, joints, joints - 1, &mut column);
+        project(&mut column);
+        for (c, v) in column.iter().enumerate() {
+            pseudo_inverse[(d, c)] = *v;
+        }
+    }
+    Some((particular, null, pseudo_inverse))
+}
