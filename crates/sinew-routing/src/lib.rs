@@ -58,4 +58,6 @@ pub use routing::{
     Cable, CableView, Hole, HoleView, MIN_SEGMENT_LENGTH, ROUTED_ROUTING_FILE, ROUTING_FILE,
     Routing, RoutingModel, RoutingView, Segment, load, routing_file,
 };
-pub use spec::{ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec};
+pub use spec::{
+    CableFriction, ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec,
+};
