@@ -44,12 +44,17 @@
 #![deny(missing_docs)]
 
 mod error;
+mod friction;
 mod geometry;
 mod routing;
 pub mod spec;
 mod vec3;
 
 pub use error::{JointProblem, Result, RoutingError};
+pub use friction::{
+    DofRow, FrictionData, FrictionModel, Slip, WRAP_KINK, compute_capstan_weights,
+    compute_friction_geometry,
+};
 pub use geometry::{
     HessianBatch, Order, RoutingData, SegmentHessians, compute_cable_geometry,
     compute_cable_geometry_from_kinematics,
