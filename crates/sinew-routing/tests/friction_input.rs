@@ -98,6 +98,27 @@ fn per_cable_keys_override_the_routing_wide_coefficient() {
     assert_eq!(model.with_friction_coefficient(0.0).unwrap().friction_coefficients(), &[0.0]);
 }
 
+/// The friction example of docs/cli.md, added to cdhrm5's pattern file, loads as it says.
+#[test]
+fn the_friction_example_of_the_cli_docs_loads() {
+    let root = cdhrm5::workspace_root();
+    let doc = std::fs::read_to_string(root.join("docs/cli.md")).unwrap();
+    let block = doc
+        .split("```toml\n")
+        .skip(1)
+        .map(|b| b.split("```").next().unwrap())
+        .find(|b| b.contains("[pattern.cable.j2c1]"))
+        .expect("the friction example");
+    // Its top-level key goes before the file's tables, its table after them.
+    let (top, table) = block.split_at(block.find('[').unwrap());
+    let file = std::fs::read_to_string(cdhrm5::dir().join("cables.toml")).unwrap();
+    let routing = load(&format!("{top}\n{file}\n{table}")).unwrap();
+    assert_eq!(routing.friction_coefficient(), 0.1);
+    let j2c1 = &routing.cables()[routing.cable_index("j2c1").unwrap()];
+    assert_eq!(j2c1.friction_coefficient, 0.2);
+    assert!((j2c1.entry_direction - Vector3::new(0.0, 0.1, 1.0).normalize()).norm() <= 1e-16);
+}
+
 #[test]
 fn the_entry_direction_is_given_in_the_first_holes_link_frame() {
     // Random chains: the disc links have random rpy in their bodies, so +z of the link is not
