@@ -10,7 +10,7 @@ use sinew_routing::{
     compute_cable_geometry, compute_capstan_weights, compute_friction_geometry,
 };
 use sinew_testkit::cdhrm5;
-use sinew_testkit::config::{random_qs, rng};
+use sinew_testkit::config::random_qs;
 use sinew_testkit::random_chain::RandomChain;
 
 const FILE: &str = "test/cables.toml";
@@ -321,7 +321,7 @@ fn the_friction_stages_refuse_what_they_cannot_compute() {
     assert!(data.wrap_gradient(&model, 0, holes - 1).is_err(), "the anchor has no wrap angle");
     assert!(data.wrap_gradient(&model, 0, holes - 2).is_ok());
     // A model, workspace or routing workspace of another routing.
-    let (other_robot, other) = cdhrm5::robot_and_routing(sinew_routing::PatternModel::Decoupled);
+    let (_, other) = cdhrm5::robot_and_routing(sinew_routing::PatternModel::Decoupled);
     let other_model = FrictionModel::new(&other);
     let mut other_data = FrictionData::new(&other_model);
     assert!(matches!(
@@ -336,5 +336,4 @@ fn the_friction_stages_refuse_what_they_cannot_compute() {
         compute_capstan_weights(&model, &mut other_data, Slip::Pull),
         Err(RoutingError::WorkspaceMismatch { .. })
     ));
-    let _ = (other_robot, rng(0));
 }
