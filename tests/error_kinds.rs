@@ -99,6 +99,40 @@ fn routing_errors() -> Vec<(RoutingError, ErrorKind)> {
         (RoutingError::DimensionMismatch { what: "q", expected: 10, got: 9 }, ErrorKind::Input),
         (RoutingError::NoSuchCable { cable: 9, cables: 3 }, ErrorKind::Input),
         (
+            RoutingError::InvalidFrictionCoefficient {
+                file: "cables.toml".into(),
+                cable: "c".into(),
+                field: "cable[0].friction_coefficient".into(),
+                value: -0.1,
+            },
+            ErrorKind::Input,
+        ),
+        (
+            RoutingError::InvalidEntryDirection {
+                file: "cables.toml".into(),
+                cable: "c".into(),
+                field: "cable[0].entry_direction".into(),
+                direction: [0.0; 3],
+            },
+            ErrorKind::Input,
+        ),
+        (
+            RoutingError::UnknownCable {
+                file: "cables.toml".into(),
+                field: "pattern.cable.x".into(),
+                cable: "x".into(),
+                joints: 5,
+            },
+            ErrorKind::Input,
+        ),
+        (
+            RoutingError::FrictionNotComputed {
+                what: "capstan weights",
+                call: "compute_capstan_weights",
+            },
+            ErrorKind::Input,
+        ),
+        (
             RoutingError::NotComputed { what: "Hessians", needed: sinew::routing::Order::Hessians },
             ErrorKind::Input,
         ),

@@ -181,6 +181,55 @@ pub enum RoutingError {
         /// What the value must be.
         expected: &'static str,
     },
+    /// A friction coefficient μ that is negative or not finite (spec §9). `cable` is empty for
+    /// the file's `friction_coefficient`, which applies to every cable without its own.
+    #[error(
+        "{file}: {}{field} = {}: the friction coefficient μ must be finite and ≥ 0{}",
+        cable_prefix(.cable), Compact(*.value),
+        if .cable.is_empty() { " (applies to every cable without its own)" } else { "" }
+    )]
+    InvalidFrictionCoefficient {
+        /// The routing file (or what set μ).
+        file: String,
+        /// The cable, or empty for the routing-wide value.
+        cable: String,
+        /// The field (`friction_coefficient`, `cable[2].friction_coefficient`,
+        /// `pattern.cable.j1c2.friction_coefficient`).
+        field: String,
+        /// The value read.
+        value: f64,
+    },
+    /// A cable's entry direction (the free length's direction at its first hole) of zero length
+    /// or with a non-finite coordinate: it gives no direction.
+    #[error(
+        "{file}: cable `{cable}`: {field} = [{}, {}, {}]: the entry direction must be finite and of non-zero length",
+        Compact(.direction[0]), Compact(.direction[1]), Compact(.direction[2])
+    )]
+    InvalidEntryDirection {
+        /// The routing file.
+        file: String,
+        /// The cable.
+        cable: String,
+        /// The field (`cable[0].entry_direction`, `pattern.cable.j1c1.entry_direction`).
+        field: String,
+        /// The vector read, in the first hole's link frame.
+        direction: [f64; 3],
+    },
+    /// A per-cable table of the pattern form (`[pattern.cable.NAME]`) names a cable the pattern
+    /// does not make.
+    #[error(
+        "{file}: {field}: the pattern has no cable `{cable}` (its cables are j1c1 … j{joints}c3)"
+    )]
+    UnknownCable {
+        /// The routing file.
+        file: String,
+        /// The table (`pattern.cable.NAME`).
+        field: String,
+        /// The name given.
+        cable: String,
+        /// The pattern's number of universal joints.
+        joints: usize,
+    },
     /// A per-joint list of the pattern (discs, radii, free lengths) whose length is not the
     /// number of universal joints.
     #[error("{file}: {field} has {got} entries; the robot has {expected} universal joints")]
@@ -261,6 +310,14 @@ pub enum RoutingError {
         /// The evaluation order that computes it.
         needed: crate::Order,
     },
+    /// A friction quantity was asked for before the call that computes it.
+    #[error("{what} not computed: call {call} first")]
+    FrictionNotComputed {
+        /// What was asked for.
+        what: &'static str,
+        /// The function that computes it.
+        call: &'static str,
+    },
     /// Serializing the expanded routing failed.
     #[error("cannot serialize the routing: {message}")]
     Serialize {
@@ -296,12 +353,16 @@ impl RoutingError {
             | RoutingError::InvalidMaterial { .. }
             | RoutingError::InvalidTensionLimits { .. }
             | RoutingError::InvalidValue { .. }
+            | RoutingError::InvalidFrictionCoefficient { .. }
+            | RoutingError::InvalidEntryDirection { .. }
+            | RoutingError::UnknownCable { .. }
             | RoutingError::PatternSize { .. }
             | RoutingError::RobotMismatch { .. }
             | RoutingError::WorkspaceMismatch { .. }
             | RoutingError::DimensionMismatch { .. }
             | RoutingError::NoSuchCable { .. }
-            | RoutingError::NotComputed { .. } => ErrorKind::Input,
+            | RoutingError::NotComputed { .. }
+            | RoutingError::FrictionNotComputed { .. } => ErrorKind::Input,
         }
     }
 }

@@ -36,6 +36,13 @@
 //! # Ok(()) }
 //! ```
 //!
+//! Friction at the holes (spec §9, geometry only): each cable's μ and entry direction come from
+//! the routing file (default μ = 0); [`FrictionModel`] and its workspace [`FrictionData`] give
+//! every segment's length `ℓ_s`, `J_s` and `H_s`, the wrap angle `θ` at every hole and its
+//! gradient ([`compute_friction_geometry`]), and the `pull`/`release` capstan weights `w_s`,
+//! `∂w_s/∂Q` and the effective Jacobian `J̃_c = Σ_s w_s J_s` ([`compute_capstan_weights`]). At
+//! μ = 0 the weights are exactly 1 and `J̃_c` is `J_c` bit for bit.
+//!
 //! Conventions: SI units (m, rad, Pa, N); universal joint `i` (0-based) is the revolute pair
 //! `2i` (about x), `2i + 1` (about y); cables are ordered by the universal joint they drive.
 //!
@@ -44,12 +51,17 @@
 #![deny(missing_docs)]
 
 mod error;
+mod friction;
 mod geometry;
 mod routing;
 pub mod spec;
 mod vec3;
 
 pub use error::{JointProblem, Result, RoutingError};
+pub use friction::{
+    DofRow, FrictionData, FrictionModel, Slip, WRAP_KINK, compute_capstan_weights,
+    compute_friction_geometry,
+};
 pub use geometry::{
     HessianBatch, Order, RoutingData, SegmentHessians, compute_cable_geometry,
     compute_cable_geometry_from_kinematics,
@@ -58,4 +70,6 @@ pub use routing::{
     Cable, CableView, Hole, HoleView, MIN_SEGMENT_LENGTH, ROUTED_ROUTING_FILE, ROUTING_FILE,
     Routing, RoutingModel, RoutingView, Segment, load, routing_file,
 };
-pub use spec::{ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec};
+pub use spec::{
+    CableFriction, ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec,
+};

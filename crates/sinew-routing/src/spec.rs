@@ -90,6 +90,36 @@
 //!
 //! The elastic length of a cable is `l_c = free_length + L_c(Q = 0)` (the free length from the
 //! actuator plus the routed length), its stiffness `k_c = E·A / l_c` (eq. 13).
+//!
+//! **Friction at the holes** (spec §9; optional, either form). Absent, every cable has μ = 0 and
+//! the numbers are the frictionless model's, bit for bit.
+//!
+//! ```toml
+//! friction_coefficient = 0.1             # μ at every hole of every cable, ≥ 0 (default 0)
+//!
+//! [[cable]]                              # explicit form: per-cable keys
+//! name = "a"
+//! friction_coefficient = 0.15            # optional: this cable's μ, overrides the top-level one
+//! entry_direction = [0.0, 0.1, 1.0]      # optional: see below (any length > 0; normalised)
+//! holes = [ … ]
+//!
+//! [pattern.cable.j2c1]                   # pattern form: per-cable keys, by the cable's name
+//! friction_coefficient = 0.2
+//! entry_direction = [0.0, 0.0, 1.0]
+//! ```
+//!
+//! `entry_direction` is the direction along which the free length arrives at the cable's first
+//! hole, going away from the actuator, in the frame of the first hole's link (the frame its
+//! `point` is given in); the wrap angle at the first hole is measured from it. Default `+z` of
+//! that link: the arm's axis on a disc, so that a straight arm has no wrap there. In the pattern
+//! form the first hole is on the base disc (routed: the cable arrives from below) or on the
+//! proximal disc of the cable's joint (decoupled: it arrives along the central channel). A
+//! negative or non-finite μ, an entry direction of zero length or with a non-finite coordinate,
+//! and a `[pattern.cable.NAME]` for a cable the pattern does not have are errors naming the file,
+//! the cable and the key. Conventions of the friction geometry: `docs/ARCHITECTURE.md`
+//! ("Friction at the holes: conventions").
+
+use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
@@ -171,6 +201,23 @@ pub struct Pattern {
     pub proximal_discs: Vec<String>,
     /// The distal disc link of each universal joint (frame `O'_i`), base first.
     pub distal_discs: Vec<String>,
+    /// Per-cable friction keys by cable name (`[pattern.cable.j1c2]`): each names a cable of
+    /// the pattern.
+    #[serde(default, rename = "cable", skip_serializing_if = "BTreeMap::is_empty")]
+    pub cables: BTreeMap<String, CableFriction>,
+}
+
+/// The friction keys of one cable of the pattern form (`[pattern.cable.NAME]`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CableFriction {
+    /// This cable's friction coefficient μ (≥ 0); default the file's `friction_coefficient`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<f64>,
+    /// The free length's direction at the first hole, in that hole's link frame (module docs);
+    /// default `[0, 0, 1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub entry_direction: Option<[f64; 3]>,
 }
 
 /// One hole of an explicit cable: a point fixed in a link's frame.
@@ -200,6 +247,13 @@ pub struct ExplicitCable {
     /// `[f_min, f_max]` of this cable, N; default the file's `tension_limits`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tension_limits: Option<[f64; 2]>,
+    /// This cable's friction coefficient μ (≥ 0); default the file's `friction_coefficient`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<f64>,
+    /// The free length's direction at the first hole, in that hole's link frame (module docs);
+    /// default `[0, 0, 1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub entry_direction: Option<[f64; 3]>,
     /// The holes from the base to the anchor (the last one).
     pub holes: Vec<HoleSpec>,
 }
@@ -216,6 +270,10 @@ pub struct RoutingSpec {
     pub free_length: Option<PerJoint>,
     /// The cable material.
     pub material: Material,
+    /// The friction coefficient μ at every hole (spec §9), ≥ 0, of every cable that does not
+    /// give its own; default 0 (no friction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<f64>,
     /// The per-joint pattern form.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pattern: Option<Pattern>,

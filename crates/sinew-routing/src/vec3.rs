@@ -37,3 +37,13 @@ pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
+
+/// `R v` for `frame = [R (column-major), t]`: a direction turned, not moved.
+#[inline(always)]
+pub(crate) fn rotate(frame: &[f64; 12], v: &[f64; 3]) -> [f64; 3] {
+    [
+        frame[0] * v[0] + frame[3] * v[1] + frame[6] * v[2],
+        frame[1] * v[0] + frame[4] * v[1] + frame[7] * v[2],
+        frame[2] * v[0] + frame[5] * v[1] + frame[8] * v[2],
+    ]
+}

@@ -139,6 +139,7 @@ pub fn chain_routing_spec(chain: &UniformChain, model: PatternModel) -> RoutingS
         tension_limits: TENSION_LIMITS,
         free_length: Some(free_length),
         material: Material { youngs_modulus: YOUNGS_MODULUS, diameter: Some(DIAMETER), area: None },
+        friction_coefficient: None,
         pattern: Some(Pattern {
             model,
             radius: Some(PerJoint::Uniform(HOLE_RADIUS)),
@@ -148,6 +149,7 @@ pub fn chain_routing_spec(chain: &UniformChain, model: PatternModel) -> RoutingS
             joint_offset: JOINT_OFFSET,
             proximal_discs: proximal_discs(n),
             distal_discs: distal_discs(n),
+            cables: Default::default(),
         }),
         cables: Vec::new(),
     }

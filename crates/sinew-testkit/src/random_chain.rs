@@ -313,6 +313,7 @@ impl RandomChain {
                 diameter: Some(DIAMETER),
                 area: None,
             },
+            friction_coefficient: None,
             pattern: None,
             cables: Vec::new(),
         }
@@ -332,6 +333,7 @@ impl RandomChain {
                 joint_offset: std::f64::consts::TAU / 15.0,
                 proximal_discs: crate::cdhrm5::proximal_discs(n),
                 distal_discs: crate::cdhrm5::distal_discs(n),
+                cables: Default::default(),
             }),
             ..self.common_spec(PerJoint::Uniform(3.0))
         }
@@ -371,6 +373,8 @@ impl RandomChain {
                     joint: None,
                     free_length: None,
                     tension_limits: None,
+                    friction_coefficient: None,
+                    entry_direction: None,
                     holes,
                 });
             }

@@ -36,6 +36,7 @@ use crate::error::{Result, RoutingError};
 use crate::routing::{Routing, Segment, check_shape, rigid_length};
 
 pub use compute::{compute_cable_geometry, compute_cable_geometry_from_kinematics};
+pub(crate) use segment::{Kinematics, length_derivative, segment_vector};
 
 /// What an evaluation computes; each order includes the ones before it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -111,7 +112,7 @@ impl RoutingData {
         self.computed
     }
 
-    fn need(&self, order: Order, what: &'static str) -> Result<()> {
+    pub(crate) fn need(&self, order: Order, what: &'static str) -> Result<()> {
         match self.computed {
             Some(done) if done >= order => Ok(()),
             _ => Err(RoutingError::NotComputed { what, needed: order }),
@@ -241,7 +242,15 @@ impl RoutingData {
         }
     }
 
-    fn check(&self, routing: &Routing) -> Result<()> {
+    /// The kinematics of the last evaluation as plain arrays (body frames, joint axes, joint
+    /// origins; base frame), for the friction geometry: valid once [`RoutingData::computed`]
+    /// is `Some`.
+    pub(crate) fn kinematics(&self) -> Kinematics<'_> {
+        (&self.frames, &self.axes, &self.origins)
+    }
+
+    /// Check that the workspace was sized for `routing`.
+    pub(crate) fn check(&self, routing: &Routing) -> Result<()> {
         for (what, expected, got) in [
             ("routing workspace (cables)", routing.cables.len(), self.cables),
             ("routing workspace (joints)", routing.dof, self.dof),

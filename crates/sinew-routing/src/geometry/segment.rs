@@ -19,7 +19,7 @@ pub(super) struct Outputs<'a> {
 }
 
 /// The kinematics as plain arrays: body frames, joint axes, joint origins (base frame).
-pub(super) type Kinematics<'a> = (&'a [[f64; 12]], &'a [[f64; 3]], &'a [[f64; 3]]);
+pub(crate) type Kinematics<'a> = (&'a [[f64; 12]], &'a [[f64; 3]], &'a [[f64; 3]]);
 
 pub(super) fn degenerate(routing: &Routing, seg: &Segment, length: f64) -> RoutingError {
     let cable = routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default();
@@ -50,10 +50,7 @@ pub(super) fn one_segment(
         out.lengths[seg.cable] += length;
         return Ok(());
     }
-    let o_p_a = transform(frame_a, &seg.proximal_point);
-    let o_p_b = transform(frame_b, &seg.distal_point);
-    let d = sub(&o_p_b, &o_p_a);
-    let length = dot(&d, &d).sqrt();
+    let (o_p_b, d, length) = segment_vector(frame_a, frame_b, seg);
     if length.is_nan() || length < MIN_SEGMENT_LENGTH {
         return Err(degenerate(routing, seg, length));
     }
@@ -103,8 +100,7 @@ fn segment_derivatives<const N: usize>(
     let mut v = [[0.0; 3]; N];
     let mut g = [0.0; N];
     for k in 0..N {
-        let v_k = cross(&axes[k], &sub(o_p_b, &origins[k]));
-        let g_k = dot(u, &v_k);
+        let (v_k, g_k) = length_derivative(&axes[k], &origins[k], o_p_b, u);
         v[k] = v_k;
         g[k] = g_k;
         column[k * m] += g_k;
@@ -131,9 +127,7 @@ fn segment_derivatives_any(
 ) {
     let n = axes.len();
     for k in 0..n {
-        // v_k = a_k × (o_p_B − p_k) = ∂d/∂q_k,  g_k = u · v_k = ∂L/∂q_k.
-        let v_k = cross(&axes[k], &sub(o_p_b, &origins[k]));
-        let g_k = dot(u, &v_k);
+        let (v_k, g_k) = length_derivative(&axes[k], &origins[k], o_p_b, u);
         v[k] = v_k;
         g[k] = g_k;
         column[k * m] += g_k;
@@ -149,6 +143,35 @@ fn segment_derivatives_any(
             block[k + i * n] = h;
         }
     }
+}
+
+/// A segment across joints at the kinematics: its distal hole `o_p_B`, `d = o_p_B − o_p_A`
+/// and `L = |d|` (base frame), from its two bodies' frames. The one formula of every loop that
+/// needs a segment's vector (this file's, and the friction geometry's, which must give the
+/// same `J_c` bit for bit).
+#[inline(always)]
+pub(crate) fn segment_vector(
+    frame_a: &[f64; 12],
+    frame_b: &[f64; 12],
+    seg: &Segment,
+) -> ([f64; 3], [f64; 3], f64) {
+    let o_p_a = transform(frame_a, &seg.proximal_point);
+    let o_p_b = transform(frame_b, &seg.distal_point);
+    let d = sub(&o_p_b, &o_p_a);
+    (o_p_b, d, dot(&d, &d).sqrt())
+}
+
+/// `v_k = a_k × (o_p_B − p_k) = ∂d/∂q_k` and `g_k = u · v_k = ∂L/∂q_k` (eq. 3) for a joint `k`
+/// between a segment's two bodies, with axis `a_k` through `p_k`.
+#[inline(always)]
+pub(crate) fn length_derivative(
+    axis: &[f64; 3],
+    origin: &[f64; 3],
+    o_p_b: &[f64; 3],
+    u: &[f64; 3],
+) -> ([f64; 3], f64) {
+    let v_k = cross(axis, &sub(o_p_b, origin));
+    (v_k, dot(u, &v_k))
 }
 
 pub(super) fn mismatch(dof: usize) -> RoutingError {

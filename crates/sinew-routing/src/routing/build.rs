@@ -12,6 +12,7 @@ use super::expand::{
     CheckedCable, check_cable, check_material, check_per_joint, expand_explicit, expand_pattern,
     valid_limits,
 };
+use super::friction::check_coefficient;
 use super::{Cable, MIN_SEGMENT_LENGTH, ROUTING_FILE, Routing, RoutingModel, Segment, SegmentPlan};
 use crate::error::{Result, RoutingError};
 use crate::spec::{PatternModel, RoutingSpec};
@@ -35,6 +36,10 @@ impl Routing {
         if !valid_limits(f_min, f_max) {
             return Err(RoutingError::InvalidTensionLimits { file, f_min, f_max });
         }
+        let friction_coefficient = match spec.friction_coefficient {
+            Some(mu) => check_coefficient(&file, "", "friction_coefficient", mu)?,
+            None => 0.0,
+        };
         if let Some(free) = &spec.free_length {
             check_per_joint(&file, "free_length", free, n, |v| v >= 0.0, "finite and ≥ 0 m")?;
         }
@@ -90,7 +95,15 @@ impl Routing {
         let mut hessian_len = 0;
         let mut max_span = 0;
         for (c, (r, checked)) in checked.into_iter().enumerate() {
-            let CheckedCable { joint, free_length, limits, holes } = checked;
+            let CheckedCable {
+                joint,
+                free_length,
+                limits,
+                holes,
+                friction_coefficient,
+                entry_direction,
+                entry_in_body,
+            } = checked;
             let first_segment = segments.len();
             let mut routed_length = 0.0;
             let (mut lo, mut hi) = (usize::MAX, 0);
@@ -151,6 +164,9 @@ impl Routing {
                 stiffness,
                 segments: first_segment..segments.len(),
                 dofs: if lo < hi { lo..hi } else { 0..0 },
+                friction_coefficient,
+                entry_direction,
+                entry_in_body,
             });
         }
 
@@ -171,6 +187,7 @@ impl Routing {
             youngs_modulus: spec.material.youngs_modulus,
             area,
             tension_limits: spec.tension_limits,
+            friction_coefficient,
             uniform_limits: cable_limits.iter().all(|l| *l == spec.tension_limits),
             cable_limits,
             joint_groups: groups.to_vec(),

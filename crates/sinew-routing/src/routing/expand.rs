@@ -5,6 +5,9 @@ use nalgebra::Vector3;
 use sinew_robot::Robot;
 
 use super::Hole;
+use super::friction::{
+    DEFAULT_ENTRY_DIRECTION, check_coefficient, check_entry_direction, check_pattern_names,
+};
 use crate::error::{JointProblem, Result, RoutingError};
 use crate::spec::{PatternModel, PerJoint, RoutingSpec};
 
@@ -20,6 +23,10 @@ pub(super) struct RawCable {
     pub(super) tension_limits: Option<([f64; 2], String)>,
     /// Link, point in the link frame, field naming the link.
     pub(super) holes: Vec<(String, [f64; 3], String)>,
+    /// An explicit friction coefficient, with its field.
+    pub(super) friction: Option<(f64, String)>,
+    /// An explicit entry direction, with its field.
+    pub(super) entry_direction: Option<([f64; 3], String)>,
 }
 
 /// The cross-section area from the material, checked.
@@ -169,16 +176,27 @@ pub(super) fn expand_pattern(
             }
             holes.push(hole(&pattern.proximal_discs, "proximal", &proximal_radius, i, theta));
             holes.push(hole(&pattern.distal_discs, "distal", &distal_radius, i, theta));
+            let name = format!("j{}c{}", i + 1, k + 1);
+            let keys = pattern.cables.get(&name);
+            let field = |key: &str| format!("pattern.cable.{name}.{key}");
             cables.push(RawCable {
-                name: format!("j{}c{}", i + 1, k + 1),
                 field: "pattern".to_owned(),
                 joint: Some(i),
                 free_length: None,
                 tension_limits: None,
                 holes,
+                friction: keys
+                    .and_then(|f| f.friction_coefficient)
+                    .map(|v| (v, field("friction_coefficient"))),
+                entry_direction: keys
+                    .and_then(|f| f.entry_direction)
+                    .map(|v| (v, field("entry_direction"))),
+                name,
             });
         }
     }
+    let names = cables.iter().map(|c| c.name.as_str()).collect();
+    check_pattern_names(file, pattern, &names, n)?;
     Ok(cables)
 }
 
@@ -192,6 +210,12 @@ pub(super) fn expand_explicit(cables: &[crate::spec::ExplicitCable]) -> Vec<RawC
             joint: cable.joint,
             free_length: cable.free_length.map(|v| (v, format!("cable[{c}].free_length"))),
             tension_limits: cable.tension_limits.map(|v| (v, format!("cable[{c}].tension_limits"))),
+            friction: cable
+                .friction_coefficient
+                .map(|v| (v, format!("cable[{c}].friction_coefficient"))),
+            entry_direction: cable
+                .entry_direction
+                .map(|v| (v, format!("cable[{c}].entry_direction"))),
             holes: cable
                 .holes
                 .iter()
@@ -328,7 +352,26 @@ pub(super) fn check_cable(
         }
         None => spec.tension_limits,
     };
-    Ok(CheckedCable { joint, free_length, limits, holes })
+    let friction_coefficient = match &cable.friction {
+        Some((v, field)) => check_coefficient(file, name, field, *v)?,
+        None => spec.friction_coefficient.unwrap_or(0.0),
+    };
+    let entry_direction = match &cable.entry_direction {
+        Some((v, field)) => check_entry_direction(file, name, field, *v)?,
+        None => Vector3::from(DEFAULT_ENTRY_DIRECTION),
+    };
+    // At least two holes (checked above): the first hole's link is known to the robot.
+    let first_link = robot.link(&holes[0].link)?;
+    let entry_in_body = first_link.body_m_link.rotation * entry_direction;
+    Ok(CheckedCable {
+        joint,
+        free_length,
+        limits,
+        holes,
+        friction_coefficient,
+        entry_direction,
+        entry_in_body,
+    })
 }
 
 /// A cable checked against the robot.
@@ -341,6 +384,12 @@ pub(super) struct CheckedCable {
     pub(super) limits: [f64; 2],
     /// Its holes.
     pub(super) holes: Vec<Hole>,
+    /// Its friction coefficient μ.
+    pub(super) friction_coefficient: f64,
+    /// Its entry direction, unit, in its first hole's link frame.
+    pub(super) entry_direction: Vector3<f64>,
+    /// The same in the first hole's body frame.
+    pub(super) entry_in_body: Vector3<f64>,
 }
 
 /// Tension limits a cable can have: `0 ≤ f_min < f_max`, both finite.

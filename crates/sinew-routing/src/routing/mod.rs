@@ -6,6 +6,7 @@
 
 mod build;
 mod expand;
+mod friction;
 mod plan;
 mod view;
 
@@ -91,6 +92,24 @@ pub struct Cable {
     /// The revolute joints its length depends on (empty only if it never crosses a joint,
     /// which loading rejects): `J_c[c, j]` is exactly zero outside this range.
     pub dofs: Range<usize>,
+    /// Its friction coefficient μ at every hole (spec §9), ≥ 0: the file's per-cable value, else
+    /// the routing-wide one ([`Routing::friction_coefficient`]), else 0.
+    pub friction_coefficient: f64,
+    /// The direction along which its free length arrives at its first hole (going away from
+    /// the actuator), unit, in the frame of the first hole's link (the frame of
+    /// `holes[0].point`); default `+z` of that link. The wrap angle at the first hole is
+    /// measured from it (`crate::friction`).
+    pub entry_direction: Vector3<f64>,
+    /// [`Cable::entry_direction`] in the frame of the first hole's body (`holes[0].body_point`).
+    pub(crate) entry_in_body: Vector3<f64>,
+}
+
+impl Cable {
+    /// [`Cable::entry_direction`] in the frame of the body carrying the first hole
+    /// (`holes[0].body_point.body`), unit: the link's rotation in its body applied to it.
+    pub fn entry_direction_in_body(&self) -> Vector3<f64> {
+        self.entry_in_body
+    }
 }
 
 /// A straight segment between two consecutive holes of a cable.
@@ -134,6 +153,7 @@ pub struct Routing {
     pub(crate) youngs_modulus: f64,
     pub(crate) area: f64,
     pub(crate) tension_limits: [f64; 2],
+    pub(crate) friction_coefficient: f64,
     pub(crate) cable_limits: Vec<[f64; 2]>,
     pub(crate) uniform_limits: bool,
     pub(crate) joint_groups: Vec<Range<usize>>,
@@ -193,6 +213,18 @@ impl Routing {
     /// ([`Routing::cable_limits`]).
     pub fn tension_limits(&self) -> [f64; 2] {
         self.tension_limits
+    }
+
+    /// The routing-wide friction coefficient μ (spec §9): the file's `friction_coefficient`,
+    /// 0 when absent; each cable's own is [`Cable::friction_coefficient`].
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction_coefficient
+    }
+
+    /// Whether some cable has friction (μ > 0). Without, the friction geometry's weights are
+    /// all exactly 1 and its effective Jacobian is `J_c` bit for bit.
+    pub fn has_friction(&self) -> bool {
+        self.cables.iter().any(|c| c.friction_coefficient > 0.0)
     }
 
     /// `[f_min, f_max]` of each cable, N (routing order).

@@ -1,0 +1,237 @@
+//! The friction geometry's workspace ([`FrictionData`]) and its accessors.
+
+use std::ops::Range;
+
+use faer::MatRef;
+
+use super::model::{FrictionModel, Slip, Slot};
+use crate::error::{Result, RoutingError};
+
+/// A row over a range of DOFs: `values[j]` is the entry of DOF `dofs.start + j`; every DOF
+/// outside `dofs` has an exact zero.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DofRow<'a> {
+    /// The DOFs the row covers.
+    pub dofs: Range<usize>,
+    /// One value per DOF of `dofs`.
+    pub values: &'a [f64],
+}
+
+impl DofRow<'_> {
+    /// The entry of DOF `d` (0 outside [`DofRow::dofs`]).
+    pub fn get(&self, d: usize) -> f64 {
+        if self.dofs.contains(&d) { self.values[d - self.dofs.start] } else { 0.0 }
+    }
+}
+
+/// The reusable workspace of a [`FrictionModel`] (Pinocchio's *data*): the friction geometry
+/// at one configuration and one slip regime's weights, sized once so that computing them
+/// allocates nothing. Rows are indexed as in the module docs of `crate::friction`: per cable,
+/// friction segment `s = 0 … H−1` (0 the free length) and hole `k = 0 … H−2`.
+#[derive(Debug, Clone)]
+pub struct FrictionData {
+    pub(crate) geometry: bool,
+    pub(crate) slip: Option<Slip>,
+    pub(crate) cables: usize,
+    pub(crate) dof: usize,
+    /// `ℓ_s`, m, per entry.
+    pub(crate) lengths: Vec<f64>,
+    /// `u_s` (base frame, unit, away from the actuator), per entry.
+    pub(crate) directions: Vec<[f64; 3]>,
+    /// Hole `s` in the base frame, per entry.
+    pub(crate) positions: Vec<[f64; 3]>,
+    /// `J_s`, per entry's jacobian slot.
+    pub(crate) jacobians: Vec<f64>,
+    /// `θ_k` per entry (0 at the anchor).
+    pub(crate) wrap: Vec<f64>,
+    /// Whether `|u_k × u_{k+1}| <` [`super::WRAP_KINK`], per entry.
+    pub(crate) kinked: Vec<bool>,
+    /// `∂θ_k/∂Q`, per entry's wrap slot.
+    pub(crate) wrap_gradients: Vec<f64>,
+    /// `w_s`, per entry.
+    pub(crate) weights: Vec<f64>,
+    /// `∂w_s/∂Q`, per entry's weight slot.
+    pub(crate) weight_gradients: Vec<f64>,
+    /// `J̃_c`, m × dof, column-major.
+    pub(crate) effective_jacobian: Vec<f64>,
+    /// Scratch: `Σ_{k<s} ∂θ_k/∂Q` over the DOFs (one per DOF).
+    pub(crate) sum: Vec<f64>,
+}
+
+impl FrictionData {
+    /// A workspace sized for `model`.
+    pub fn new(model: &FrictionModel) -> FrictionData {
+        let n = model.entries.len();
+        let m = model.cables.len();
+        FrictionData {
+            geometry: false,
+            slip: None,
+            cables: m,
+            dof: model.dof,
+            lengths: vec![0.0; n],
+            directions: vec![[0.0; 3]; n],
+            positions: vec![[0.0; 3]; n],
+            jacobians: vec![0.0; model.jacobian_len],
+            wrap: vec![0.0; n],
+            kinked: vec![false; n],
+            wrap_gradients: vec![0.0; model.wrap_len],
+            weights: vec![0.0; n],
+            weight_gradients: vec![0.0; model.weight_len],
+            effective_jacobian: vec![0.0; m * model.dof],
+            sum: vec![0.0; model.dof],
+        }
+    }
+
+    /// The regime of the last [`crate::compute_capstan_weights`] since the geometry was last
+    /// computed (`None` before, or after a failed computation).
+    pub fn slip(&self) -> Option<Slip> {
+        self.slip
+    }
+
+    /// Friction segment lengths `ℓ_s` of cable `c`, m (`H` values; `[0]` the free length).
+    ///
+    /// # Errors
+    /// [`RoutingError::NotComputed`] before [`crate::compute_friction_geometry`],
+    /// [`RoutingError::NoSuchCable`], [`RoutingError::WorkspaceMismatch`].
+    pub fn lengths(&self, model: &FrictionModel, c: usize) -> Result<&[f64]> {
+        Ok(&self.lengths[self.geometry_of(model, c)?])
+    }
+
+    /// The unit directions `u_s` of cable `c`'s friction segments in the base frame, pointing
+    /// away from the actuator (`H` values; `[0]` the entry direction at the pose).
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`].
+    pub fn directions(&self, model: &FrictionModel, c: usize) -> Result<&[[f64; 3]]> {
+        Ok(&self.directions[self.geometry_of(model, c)?])
+    }
+
+    /// `J_s = ∂ℓ_s/∂Q` of friction segment `s` of cable `c` (m/rad), over the routing segment's
+    /// DOFs (empty for `s = 0` and for a segment within one body).
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`]; [`RoutingError::DimensionMismatch`] for `s ≥ H`.
+    pub fn segment_jacobian(
+        &self,
+        model: &FrictionModel,
+        c: usize,
+        s: usize,
+    ) -> Result<DofRow<'_>> {
+        self.geometry_of(model, c)?;
+        Ok(row(&self.jacobians, &model.entry(c, s)?.jacobian))
+    }
+
+    /// The wrap angles `θ_k` of cable `c`, rad, one per hole but the anchor (`H − 1` values;
+    /// `[k]` at `cable.holes[k]`).
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`].
+    pub fn wrap_angles(&self, model: &FrictionModel, c: usize) -> Result<&[f64]> {
+        let range = self.geometry_of(model, c)?;
+        Ok(&self.wrap[range.start..range.end - 1])
+    }
+
+    /// Which holes of cable `c` are at the kink `θ ≈ 0` (or `≈ π`): `|u_k × u_{k+1}| <`
+    /// [`super::WRAP_KINK`], where [`FrictionData::wrap_gradient`] is 0 (`H − 1` values).
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`].
+    pub fn kinked(&self, model: &FrictionModel, c: usize) -> Result<&[bool]> {
+        let range = self.geometry_of(model, c)?;
+        Ok(&self.kinked[range.start..range.end - 1])
+    }
+
+    /// `∂θ_k/∂Q` at hole `k` of cable `c` (rad/rad), over the joints between the lowest and
+    /// the highest body of holes `k − 1, k, k + 1`; 0 at a kinked hole.
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`]; [`RoutingError::DimensionMismatch`] for `k ≥ H − 1`.
+    pub fn wrap_gradient(&self, model: &FrictionModel, c: usize, k: usize) -> Result<DofRow<'_>> {
+        let range = self.geometry_of(model, c)?;
+        if k + 1 >= range.len() {
+            let expected = range.len() - 1;
+            return Err(RoutingError::DimensionMismatch { what: "hole index", expected, got: k });
+        }
+        Ok(row(&self.wrap_gradients, &model.entry(c, k)?.wrap))
+    }
+
+    /// The capstan weights `w_s` of cable `c` (`H` values, `w_0 = 1`): `T_s = T_0 w_s`.
+    ///
+    /// # Errors
+    /// [`RoutingError::NotComputed`] before [`crate::compute_capstan_weights`], else as
+    /// [`FrictionData::lengths`].
+    pub fn weights(&self, model: &FrictionModel, c: usize) -> Result<&[f64]> {
+        Ok(&self.weights[self.weights_of(model, c)?])
+    }
+
+    /// `∂w_s/∂Q` of friction segment `s` of cable `c` (1/rad), over the union of the wrap rows of
+    /// holes `0 … s − 1` (empty for `s = 0`).
+    ///
+    /// # Errors
+    /// As [`FrictionData::weights`]; [`RoutingError::DimensionMismatch`] for `s ≥ H`.
+    pub fn weight_gradient(&self, model: &FrictionModel, c: usize, s: usize) -> Result<DofRow<'_>> {
+        self.weights_of(model, c)?;
+        Ok(row(&self.weight_gradients, &model.entry(c, s)?.weight))
+    }
+
+    /// The effective cable Jacobian `J̃_c = Σ_s w_{c,s} J_{c,s}` of the last regime, m × dof,
+    /// m/rad (μ = 0: [`crate::RoutingData::jacobian`] bit for bit).
+    ///
+    /// # Errors
+    /// [`RoutingError::NotComputed`] before [`crate::compute_capstan_weights`].
+    pub fn effective_jacobian(&self) -> Result<MatRef<'_, f64>> {
+        if self.slip.is_none() {
+            return Err(WEIGHTS_MISSING);
+        }
+        Ok(MatRef::from_column_major_slice(&self.effective_jacobian, self.cables, self.dof))
+    }
+
+    /// Cable `c`'s entries, once the geometry is computed.
+    fn geometry_of(&self, model: &FrictionModel, c: usize) -> Result<Range<usize>> {
+        self.check(model)?;
+        if !self.geometry {
+            return Err(RoutingError::FrictionNotComputed {
+                what: "friction geometry",
+                call: "compute_friction_geometry",
+            });
+        }
+        model
+            .cables
+            .get(c)
+            .cloned()
+            .ok_or(RoutingError::NoSuchCable { cable: c, cables: model.cables.len() })
+    }
+
+    /// Cable `c`'s entries, once the weights are computed.
+    fn weights_of(&self, model: &FrictionModel, c: usize) -> Result<Range<usize>> {
+        let range = self.geometry_of(model, c)?;
+        if self.slip.is_none() {
+            return Err(WEIGHTS_MISSING);
+        }
+        Ok(range)
+    }
+
+    /// Check that the workspace was sized for `model`.
+    pub(crate) fn check(&self, model: &FrictionModel) -> Result<()> {
+        for (what, expected, got) in [
+            ("friction workspace (cables)", model.cables.len(), self.cables),
+            ("friction workspace (joints)", model.dof, self.dof),
+            ("friction workspace (entries)", model.entries.len(), self.lengths.len()),
+            ("friction workspace (Jacobian rows)", model.jacobian_len, self.jacobians.len()),
+            ("friction workspace (wrap rows)", model.wrap_len, self.wrap_gradients.len()),
+            ("friction workspace (weight rows)", model.weight_len, self.weight_gradients.len()),
+        ] {
+            if expected != got {
+                return Err(RoutingError::WorkspaceMismatch { what, expected, got });
+            }
+        }
+        Ok(())
+    }
+}
+
+fn row<'a>(store: &'a [f64], slot: &Slot) -> DofRow<'a> {
+    DofRow { dofs: slot.dofs.clone(), values: &store[slot.offset..slot.offset + slot.dofs.len()] }
+}
+
+const WEIGHTS_MISSING: RoutingError =
+    RoutingError::FrictionNotComputed { what: "capstan weights", call: "compute_capstan_weights" };
