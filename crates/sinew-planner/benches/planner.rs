@@ -1,7 +1,8 @@
 //! `cargo bench -p sinew-planner`: a certified plan (relative gap 1e-6) on cdhrm5 at the loaded
 //! pose under 5 N along y (both models, every objective, both methods), one pipeline evaluation
 //! of the same arm (the ratio is what carries to another machine), 100 warm-started steps along
-//! a 1 kHz trajectory, and a 25-joint decoupled chain (50 DOF, weightless, 0.022 N at the tip).
+//! a 1 kHz trajectory, a 25-joint decoupled chain (50 DOF, weightless, 0.022 N at the tip) and a
+//! 100-joint one (200 DOF, 0.00045 N).
 //! Prints each plan's iterations once, for the time per iteration.
 #![allow(missing_docs, clippy::unwrap_used)]
 
@@ -144,6 +145,39 @@ fn bench_plans(c: &mut Criterion) {
                 })
             });
         }
+    }
+    // The 100-joint decoupled chain (200 DOF, weightless, 0.00045 N at the tip): the
+    // interior-point method only (a plan takes a good part of a second), beside one pipeline
+    // evaluation of the same arm.
+    let (robot, routing) = cdhrm5::chain(100, PatternModel::Decoupled);
+    let robot = robot.with_gravity(Vector3::zeros());
+    let arm = ArmStiffness::new(&robot, &routing).unwrap();
+    let planner = Planner::new(arm.clone());
+    let mut data = PlannerData::new(&planner);
+    let q: Vec<f64> = (0..200).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+    let f0 = Vector6::new(0.0, 0.0004, 0.0002, 0.0, 0.0, 0.0);
+    let mut sd = ArmStiffnessData::new(&arm);
+    let levels = [0.5; 100];
+    group.bench_function("chain 100 decoupled one evaluation", |b| {
+        b.iter(|| arm.evaluate(&mut sd, black_box(&q), &f0, TensionChoice::Levels(&levels)).is_ok())
+    });
+    let settings = PlanSettings::default();
+    for objective in [Objective::StiffnessAlong(Vector3::y()), Objective::LeastTension] {
+        let plan = planner.plan(&mut data, &q, &f0, objective, &requirements, &settings).unwrap();
+        println!(
+            "chain 100 decoupled {} ipm: {} iterations, value {:.9e}, gap {:.1e}",
+            objective.name(),
+            plan.iterations,
+            plan.value,
+            plan.gap
+        );
+        group.bench_function(format!("chain 100 decoupled {} ipm", objective.name()), |b| {
+            b.iter(|| {
+                planner
+                    .plan(&mut data, black_box(&q), &f0, objective, &requirements, &settings)
+                    .is_ok()
+            })
+        });
     }
     group.finish();
 }

@@ -3,7 +3,7 @@
 //! difference divided by N), and prints the iterations and the value of the last plan.
 //!
 //! `cargo run --release -p sinew-planner --example plan_profile -- MODEL OBJECTIVE N METHOD`
-//! with MODEL `decoupled`, `routed` or `chain25` (the bench's 50-DOF chain), OBJECTIVE one of `stiffness-along`, `compliance-along`,
+//! with MODEL `decoupled`, `routed` `chain25` (the bench's 50-DOF chain) or `chain100` (200 DOF), OBJECTIVE one of `stiffness-along`, `compliance-along`,
 //! `min-stiffness`, `volume`, `least-tension`, and METHOD `ipm` or `bundle`; with METHOD
 //! `along`, N times the bench's 100-step 1 kHz trajectory, warm-started (instructions per step:
 //! the difference divided by 100 N).
@@ -40,10 +40,16 @@ fn main() {
     let mut f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     // MODEL `chain25`: the bench's 25-joint decoupled chain (50 DOF, weightless, 0.022 N at
     // the tip).
-    let (robot, routing) = if args.get(1).map(String::as_str) == Some("chain25") {
-        let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
-        q = (0..50).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
-        f0 = Vector6::new(0.0, 0.02, 0.01, 0.0, 0.0, 0.0);
+    // MODEL `chain100`: the 100-joint decoupled chain of the same kind (200 DOF, 0.00045 N at the tip).
+    let chain = match args.get(1).map(String::as_str) {
+        Some("chain25") => Some((25, 0.02)),
+        Some("chain100") => Some((100, 0.0004)),
+        _ => None,
+    };
+    let (robot, routing) = if let Some((joints, force)) = chain {
+        let (robot, routing) = cdhrm5::chain(joints, PatternModel::Decoupled);
+        q = (0..2 * joints).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+        f0 = Vector6::new(0.0, force, 0.5 * force, 0.0, 0.0, 0.0);
         (robot.with_gravity(Vector3::zeros()), routing)
     } else {
         (robot, routing)

@@ -83,27 +83,30 @@ impl Frame {
                 width.push(w);
             }
         }
-        let mut a0 = vec![0.0; n * n];
-        for r in 0..n {
+        // The symmetric parts, row-major, from the pencil's columns (`a[(r, c)]` is entry `r`
+        // of column `c`).
+        let symmetric = |a: &faer::Mat<f64>, scale: f64, out: &mut [f64]| {
             for c in 0..n {
-                let mut v = 0.5 * (pencil.a0[(r, c)] + pencil.a0[(c, r)]);
-                for (l, a) in base.iter().zip(&pencil.ai) {
-                    v += l * 0.5 * (a[(r, c)] + a[(c, r)]);
+                let column = a.col_as_slice(c);
+                for (r, v) in column.iter().enumerate() {
+                    out[r * n + c] += 0.5 * scale * v;
+                    out[c * n + r] += 0.5 * scale * v;
                 }
-                a0[r * n + c] = v;
+            }
+        };
+        let mut a0 = vec![0.0; n * n];
+        symmetric(&pencil.a0, 1.0, &mut a0);
+        for (l, a) in base.iter().zip(&pencil.ai) {
+            if *l != 0.0 {
+                symmetric(a, *l, &mut a0);
             }
         }
         let ai: Vec<Vec<f64>> = free
             .iter()
             .zip(&width)
             .map(|(&i, w)| {
-                let a = &pencil.ai[i];
                 let mut out = vec![0.0; n * n];
-                for r in 0..n {
-                    for c in 0..n {
-                        out[r * n + c] = w * 0.5 * (a[(r, c)] + a[(c, r)]);
-                    }
-                }
+                symmetric(&pencil.ai[i], *w, &mut out);
                 out
             })
             .collect();
