@@ -40,12 +40,16 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
     let steps = trajectory(1000);
     // The Newton steps on the previous active set (smooth objectives, least tension with the
     // margin not active) take one or two evaluations where the interior-point method's warm
-    // start takes four or more: `Some(2)` bounds the median for those.
-    for (model, objective, newton) in [
-        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y()), Some(2)),
-        (PatternModel::Routed, Objective::Volume, Some(2)),
-        (PatternModel::Routed, Objective::LeastTension, Some(2)),
-        (PatternModel::Routed, Objective::MinStiffness, None),
+    // start takes four or more: `Some(2)` bounds the median for those. Decoupled least tension
+    // sits on the stability margin, which the Newton steps leave to the interior-point method
+    // (and its warm start to the cold one at four steps in ten): every plan must still
+    // hold the margin.
+    for (model, objective, newton, least_warm) in [
+        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y()), Some(2), 900),
+        (PatternModel::Routed, Objective::Volume, Some(2), 900),
+        (PatternModel::Routed, Objective::LeastTension, Some(2), 900),
+        (PatternModel::Decoupled, Objective::LeastTension, None, 500),
+        (PatternModel::Routed, Objective::MinStiffness, None, 900),
     ] {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
         let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
@@ -60,6 +64,12 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
                 plan.gap >= 0.0 && plan.gap <= 1e-6 * plan.value.abs() * 1.000001,
                 "step {k}: gap {}",
                 plan.gap
+            );
+            let margin = Requirements::default().margin;
+            assert!(
+                plan.min_eigenvalue >= margin * (1.0 - 1e-9),
+                "step {k}: margin {}",
+                plan.min_eigenvalue
             );
             warm += usize::from(result.warm);
             if result.warm {
@@ -92,7 +102,7 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
             objective.name()
         );
         // The warm path is the rule along a smooth trajectory, not the exception.
-        assert!(warm >= 900, "only {warm} warm steps");
+        assert!(warm >= least_warm, "only {warm} warm steps");
         if let Some(most) = newton {
             assert!(median <= most, "median warm iterations {median}: not the Newton steps");
         }
