@@ -56,38 +56,54 @@ impl Evaluation {
 }
 
 /// The linear part: `rows[r] · λ ≤ rhs[r]`.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub(crate) struct Linear {
-    pub(crate) rows: Vec<Vec<f64>>,
+    /// Coordinates per row.
+    k: usize,
+    /// The rows `a`, row-major (rows × k).
+    rows: Vec<f64>,
     pub(crate) rhs: Vec<f64>,
 }
 
 impl Linear {
+    /// No rows, in `k` coordinates, with room for `capacity` rows.
+    pub(crate) fn new(k: usize, capacity: usize) -> Linear {
+        Linear { k, rows: Vec::with_capacity(k * capacity), rhs: Vec::with_capacity(capacity) }
+    }
+
+    /// Adds the row `a·x ≤ rhs` (`a` of `k` coordinates).
+    pub(crate) fn push(&mut self, a: impl IntoIterator<Item = f64>, rhs: f64) {
+        let before = self.rows.len();
+        self.rows.extend(a);
+        debug_assert_eq!(self.rows.len(), before + self.k);
+        self.rhs.push(rhs);
+    }
+
+    /// The rows' `a`, in order.
+    pub(crate) fn rows(&self) -> impl Iterator<Item = &[f64]> + '_ {
+        (0..self.rhs.len()).map(|r| &self.rows[r * self.k..(r + 1) * self.k])
+    }
+
     /// The same polytope with parallel rows merged (the tightest kept): in the decoupled model
     /// each cable's two limit rows bound the one coordinate of its joint, so three cables'
     /// six rows become two.
     pub(crate) fn merged(&self) -> Linear {
-        let mut out = Linear::default();
-        for (row, rhs) in self.rows.iter().zip(&self.rhs) {
+        let k = self.k;
+        let mut out = Linear::new(k, self.rhs.len());
+        for (row, rhs) in self.rows().zip(&self.rhs) {
             let scale = row.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             if scale == 0.0 {
                 // 0 ≤ rhs: keep it (an infeasible one proves infeasibility).
-                out.rows.push(row.clone());
-                out.rhs.push(*rhs);
+                out.push(row.iter().copied(), *rhs);
                 continue;
             }
-            let unit: Vec<f64> = row.iter().map(|v| v / scale).collect();
             let b = rhs / scale;
             let same = out
-                .rows
-                .iter()
-                .position(|r| r.iter().zip(&unit).all(|(x, y)| (x - y).abs() <= 1e-12));
+                .rows()
+                .position(|r| r.iter().zip(row).all(|(x, y)| (x - y / scale).abs() <= 1e-12));
             match same {
                 Some(i) => out.rhs[i] = out.rhs[i].min(b),
-                None => {
-                    out.rows.push(unit);
-                    out.rhs.push(b);
-                }
+                None => out.push(row.iter().map(|v| v / scale), b),
             }
         }
         out
@@ -95,7 +111,7 @@ impl Linear {
 
     /// Whether `x` meets every row (to `1e-9` of the row's scale).
     pub(crate) fn satisfied(&self, x: &[f64]) -> bool {
-        self.rows.iter().zip(&self.rhs).all(|(row, rhs)| {
+        self.rows().zip(&self.rhs).all(|(row, rhs)| {
             let scale = rhs.abs().max(row.iter().fold(0.0_f64, |a, v| a.max(v.abs()))).max(1.0);
             dot(row, x) <= rhs + 1e-9 * scale
         })
@@ -295,8 +311,8 @@ fn push_constraints(
         a.extend(std::iter::repeat_n(0.0, extra));
         rows.push((a, cut.offset() - bound));
     }
-    for (row, rhs) in linear.rows.iter().zip(&linear.rhs) {
-        let mut a = row.clone();
+    for (row, rhs) in linear.rows().zip(&linear.rhs) {
+        let mut a = row.to_vec();
         a.extend(std::iter::repeat_n(0.0, extra));
         rows.push((a, *rhs));
     }

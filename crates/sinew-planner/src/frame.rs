@@ -119,7 +119,7 @@ impl Frame {
         }
         let k = free.len();
         let (mut rows, mut rhs) = (Vec::new(), Vec::new());
-        for (row, h) in linear.rows.iter().zip(&linear.rhs) {
+        for (row, h) in linear.rows().zip(&linear.rhs) {
             let shift: f64 = row.iter().zip(&base).map(|(a, b)| a * b).sum();
             let g: Vec<f64> = free.iter().zip(&width).map(|(&i, w)| row[i] * w).collect();
             let scale = g.iter().fold(0.0_f64, |a, v| a.max(v.abs()));

@@ -22,21 +22,18 @@ pub(crate) fn linear_rows(
     let null = set.null_basis();
     let (m, k) = (set.cable_count(), set.dimension());
     let p = set.particular();
-    let mut linear = Linear::default();
+    // Room for the limits, the budgets and the rate rows a trajectory adds.
+    let mut linear = Linear::new(k, 4 * m + 1 + joint_budgets.len());
     for c in 0..m {
-        let row: Vec<f64> = (0..k).map(|i| null[(c, i)]).collect();
-        linear.rhs.push(set.upper()[c] - p[c]);
-        linear.rows.push(row.clone());
-        linear.rhs.push(p[c] - set.lower()[c]);
-        linear.rows.push(row.iter().map(|v| -v).collect());
+        linear.push((0..k).map(|i| null[(c, i)]), set.upper()[c] - p[c]);
+        linear.push((0..k).map(|i| -null[(c, i)]), p[c] - set.lower()[c]);
     }
     if let Some(b) = budget {
-        linear.rows.push(column_sums(set));
-        linear.rhs.push(b - p.iter().sum::<f64>());
+        linear.push(column_sums(set), b - p.iter().sum::<f64>());
     }
     for (cables, b) in joint_budgets {
-        linear.rows.push((0..k).map(|i| cables.clone().map(|c| null[(c, i)]).sum()).collect());
-        linear.rhs.push(b - cables.clone().map(|c| p[c]).sum::<f64>());
+        let row = (0..k).map(|i| cables.clone().map(|c| null[(c, i)]).sum());
+        linear.push(row, b - cables.clone().map(|c| p[c]).sum::<f64>());
     }
     linear
 }
@@ -74,14 +71,9 @@ pub(crate) fn fix_rows(
     let k = set.dimension();
     for (column, value) in held_coordinates(set, fixed) {
         let tol = 1e-9 * (1.0 + value.abs());
-        let mut up = vec![0.0; k];
-        up[column] = 1.0;
-        linear.rows.push(up);
-        linear.rhs.push(value + tol);
-        let mut down = vec![0.0; k];
-        down[column] = -1.0;
-        linear.rows.push(down);
-        linear.rhs.push(tol - value);
+        let unit = |sign: f64| (0..k).map(move |i| if i == column { sign } else { 0.0 });
+        linear.push(unit(1.0), value + tol);
+        linear.push(unit(-1.0), tol - value);
     }
 }
 
@@ -91,11 +83,8 @@ pub(crate) fn rate_rows(set: &EquilibriumSet, previous: &[f64], change: f64, lin
     let k = set.dimension();
     let p = set.particular();
     for (c, f) in previous.iter().enumerate().take(set.cable_count()) {
-        let row: Vec<f64> = (0..k).map(|i| null[(c, i)]).collect();
-        linear.rhs.push(f + change - p[c]);
-        linear.rows.push(row.clone());
-        linear.rhs.push(p[c] - (f - change));
-        linear.rows.push(row.iter().map(|v| -v).collect());
+        linear.push((0..k).map(|i| null[(c, i)]), f + change - p[c]);
+        linear.push((0..k).map(|i| -null[(c, i)]), p[c] - (f - change));
     }
 }
 

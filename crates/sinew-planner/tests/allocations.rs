@@ -52,22 +52,32 @@ fn iterations_of_the_interior_point_method_allocate_nothing() {
                     &requirements,
                     &settings,
                 );
-                let (allocations, result) = count(|| {
-                    planner.plan(
-                        &mut data,
-                        &cdhrm5::LOADED_POSE,
-                        &f0,
-                        objective,
-                        &requirements,
-                        &settings,
-                    )
-                });
-                match result {
-                    Err(PlanError::NotConverged { iterations, .. }) => {
-                        assert_eq!(iterations, cap, "{model:?} {}", objective.name());
+                // The counter is global: a thread of the test harness (or of a library's
+                // pool) can allocate during a plan, now and then, and only ever adds. The least
+                // of three counts is the plan's own.
+                let mut least = usize::MAX;
+                for _ in 0..3 {
+                    let (allocations, result) = count(|| {
+                        planner.plan(
+                            &mut data,
+                            &cdhrm5::LOADED_POSE,
+                            &f0,
+                            objective,
+                            &requirements,
+                            &settings,
+                        )
+                    });
+                    match result {
+                        Err(PlanError::NotConverged { iterations, .. }) => {
+                            assert_eq!(iterations, cap, "{model:?} {}", objective.name());
+                        }
+                        other => {
+                            panic!("{model:?} {}: capped at {cap}: {other:?}", objective.name())
+                        }
                     }
-                    other => panic!("{model:?} {}: capped at {cap}: {other:?}", objective.name()),
+                    least = least.min(allocations);
                 }
+                let allocations = least;
                 counts.push(allocations);
             }
             println!(

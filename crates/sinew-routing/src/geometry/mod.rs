@@ -225,7 +225,11 @@ impl RoutingData {
         }
         check_shape("weighted Hessian sum", out.nrows(), out.ncols(), self.dof, self.dof)?;
         for (s, seg) in routing.segments.iter().enumerate() {
-            self.add_segment(routing, s, f[seg.cable], out.as_mut());
+            // A cable of zero weight adds nothing (its Hessians are finite): the planner's
+            // `A_i` weigh only the cables of one null column.
+            if f[seg.cable] != 0.0 {
+                self.add_segment(routing, s, f[seg.cable], out.as_mut());
+            }
         }
         Ok(())
     }
