@@ -206,12 +206,20 @@ pub fn e7(robot: &Robot, routing: &Routing, template: &RoutingSpec) -> Result<E7
 }
 
 fn claim_e7(cases: &[E7Case], map: &E7Map) -> Claim {
-    let text = "Conclusion (1) with its condition (E7): more tension, more stiffness holds where A_i = Σ N_c H_c ⪰ 0; at Q0 A_i = −d1·d2/(d1 + d2)·ΣN·I, so it needs d1·d2 ≤ 0 (no holes on both sides of the joint centre); cdhrm5 (d2 = 0) meets it over its whole workspace, the off-centre geometry does not";
+    let text = "Conclusion (1) with its condition (E7): more tension, more stiffness holds where A_i = Σ N_c H_c ⪰ 0. At Q0 A_i = −d1·d2/(d1 + d2)·ΣN·I, so it needs d1·d2 ≤ 0 (the holes not on both sides of the joint centre); away from Q0 that is not enough (a gap narrow against the hole radius makes A_i indefinite at bent poses, see the map). cdhrm5 (d2 = 0) meets it over its whole workspace, the off-centre geometry does not";
     let (Some(paper), Some(off)) = (cases.first(), cases.get(1)) else {
         return Claim::unchecked(text, "no geometries");
     };
     let (agree, total) = map.closed_form_agreement();
-    let holds = paper.cell.workspace_class.tension_never_softens()
+    // Necessity over the map: wherever d1·d2 > 0, tension softens some pose.
+    let n = map.axis.len();
+    let necessary = (0..n * n).all(|k| {
+        let (d1, d2) = (map.axis[k / n], map.axis[k % n]);
+        map.cell(k / n, k % n)
+            .is_none_or(|c| d1 * d2 <= 0.0 || c.workspace_class != TensionEffect::Stiffens)
+    });
+    let holds = necessary
+        && paper.cell.workspace_class.tension_never_softens()
         && off.closed_form == Some(TensionEffect::Softens)
         && off.cell.q0_class == TensionEffect::Softens
         && off.k_x[1] < off.k_x[0]
@@ -219,7 +227,7 @@ fn claim_e7(cases: &[E7Case], map: &E7Map) -> Claim {
         && total > 0;
     let mm = |x: f64| fixed(1e3 * x, 3);
     let evidence = format!(
-        "ours: cdhrm5 (d1 = {} mm, d2 = {} mm): A_i(Q0) eigenvalues [{}, {}] mm, over the workspace [{}, {}] mm ({}); off-centre (d1 = {} mm, d2 = {} mm): closed form c = {} mm, A_i(Q0) eigenvalues [{}, {}] mm, K_x at Q0 from {} to {} N m/rad as tension rises, over the workspace [{}, {}] mm ({}); the closed form classifies {agree} of {total} map points as the numbers do",
+        "ours: cdhrm5 (d1 = {} mm, d2 = {} mm): A_i(Q0) eigenvalues [{}, {}] mm, over the workspace [{}, {}] mm ({}); off-centre (d1 = {} mm, d2 = {} mm): closed form c = {} mm, A_i(Q0) eigenvalues [{}, {}] mm, K_x at Q0 from {} to {} N m/rad as tension rises, over the workspace [{}, {}] mm ({}); the closed form classifies {agree} of {total} map points as the numbers do; no map point with d1·d2 > 0 has A_i ⪰ 0 over the workspace: {necessary}",
         mm(paper.geometry.d1),
         mm(paper.geometry.d2),
         mm(paper.cell.q0[0]),

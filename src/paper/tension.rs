@@ -67,7 +67,7 @@ use nalgebra::{Matrix2, Matrix3x2, SymmetricEigen, Vector2};
 use crate::robot::{Robot, RobotData, UniformChain};
 use crate::routing::{Order, PerJoint, Routing, RoutingData, RoutingSpec, compute_cable_geometry};
 use crate::statics::{TensionLimits, tension_interval};
-use crate::stiffness::{joint_block, joint_stiffness};
+use crate::stiffness::{joint_block, stiffness_slope};
 
 /// The hole geometry of one universal joint (eq. 1), m.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -185,8 +185,7 @@ pub fn single_joint(
     };
     let robot = chain.build()?;
     let mut spec = template.clone();
-    let first = |p: &Option<PerJoint>| p.as_ref().and_then(|v| v.get(0)).map(PerJoint::Uniform);
-    spec.free_length = first(&spec.free_length);
+    spec.free_length = spec.free_length.as_ref().and_then(|v| v.get(0)).map(PerJoint::Uniform);
     let pattern = spec.pattern.as_mut().ok_or_else(|| crate::routing::RoutingError::Parse {
         file: "<e7 template>".to_owned(),
         message: "E7 needs a routing of the pattern form".to_owned(),
@@ -225,8 +224,8 @@ pub fn joint_geometry(
 
 /// `A_i = Σ_c N_c H_c` (E7.1) of joint 0 of a one-joint robot at angles `q`, N m/rad per N:
 /// `H_c` the routing's Hessians, `N` the unit null direction of the statics' tension interval
-/// (eq. 22–23, components summing to ≥ 0), the controllable stiffness of
-/// `sinew_stiffness::joint_stiffness` at tensions `N`.
+/// (eq. 22–23, components summing to ≥ 0), and `Σ_c δf_c H_c` at `δf = N` by
+/// `sinew_stiffness::stiffness_slope`.
 ///
 /// # Errors
 /// Angles the robot refuses, a rank-deficient `J_c` (no null direction).
@@ -249,9 +248,9 @@ pub fn tension_stiffness(
     let mut f = vec![0.0; routing.cable_count()];
     f[own.start..own.start + 3].copy_from_slice(interval.null.as_slice());
     let n = robot.dof();
-    let (mut kc, mut ki) = (faer::Mat::zeros(n, n), faer::Mat::zeros(n, n));
-    joint_stiffness(routing, &g, &f, kc.as_mut(), ki.as_mut())?;
-    joint_block(kc.as_ref(), 0).ok_or_else(|| {
+    let mut slope = faer::Mat::zeros(n, n);
+    stiffness_slope(routing, &g, &f, slope.as_mut())?;
+    joint_block(slope.as_ref(), 0).ok_or_else(|| {
         crate::indicators::IndicatorError::NoSuchJoint { joint: 0, joints: n / 2 }.into()
     })
 }
