@@ -206,7 +206,7 @@ pub fn e7(robot: &Robot, routing: &Routing, template: &RoutingSpec) -> Result<E7
 }
 
 fn claim_e7(cases: &[E7Case], map: &E7Map) -> Claim {
-    let text = "Conclusion (1) with its condition (E7): more tension, more stiffness holds where A_i = Σ N_c H_c ⪰ 0. At Q0 A_i = −d1·d2/(d1 + d2)·ΣN·I, so it needs d1·d2 ≤ 0 (the holes not on both sides of the joint centre); away from Q0 that is not enough (a gap narrow against the hole radius makes A_i indefinite at bent poses, see the map). cdhrm5 (d2 = 0) meets it over its whole workspace, the off-centre geometry does not";
+    let text = "Conclusion (1) with its condition (E7): more tension, more stiffness holds where A_i = Σ N_c H_c ⪰ 0. At Q0 A_i = −d1·d2/(d1 + d2)·ΣN·I, so it needs d1·d2 ≤ 0 (the holes not on both sides of the joint centre); away from Q0 that is not enough (a gap narrow against the hole radius makes A_i indefinite at bent poses, see the map). cdhrm5 (d2 = 0) meets it at every pose of the grid over its workspace, the off-centre geometry does not";
     let (Some(paper), Some(off)) = (cases.first(), cases.get(1)) else {
         return Claim::unchecked(text, "no geometries");
     };

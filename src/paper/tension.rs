@@ -55,12 +55,13 @@
 //! `d2 = 0`), `A_i ≺ 0` iff `d1 d2 > 0` (holes below and above the centre). Both eigenvalues
 //! are equal: `A_i(Q0)` is never indefinite, and the hole radius `r` does not enter.
 //!
-//! **Away from Q0 the pose matters.** `H_c(q)` gains terms in `r² q²/L0` that the closed form
-//! does not have; on the boundary `d1 d2 = 0` they decide the sign (on cdhrm5 they make
-//! `A_i ⪰ 0` over its whole workspace), and with `d1 d2 > 0` they make `A_i` indefinite at bent
-//! poses once `r` is large against the gap. [`tension_stiffness`] computes `A_i` at any pose
-//! from the routing's own `H_c` and the statics' `N`; the E7 map (`e7.rs`) classifies over the
-//! workspace.
+//! **Away from Q0 the pose matters.** `H_c(q)` gains terms of second order in `q` that the
+//! closed form does not have. On the boundary `d1 d2 = 0` they decide the sign (on cdhrm5,
+//! `A_i ⪰ 0` at every pose of E7's 5 × 5 grid over its workspace); with `d1 d2 > 0` they make
+//! `A_i` indefinite at bent poses once `r` is large against the gap, and with `d1 d2 < 0` too
+//! when the gap is narrow (numbers, not a proof: E7's table and map). [`tension_stiffness`]
+//! computes `A_i` at any pose from the routing's own `H_c` and the statics' `N`; the E7 map
+//! (`e7.rs`) classifies over the workspace.
 
 use nalgebra::{Matrix2, Matrix3x2, SymmetricEigen, Vector2};
 
