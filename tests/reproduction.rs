@@ -243,3 +243,39 @@ fn e5_planned_tensions() {
     }
     insta::assert_snapshot!("e5_tradeoff", paper::e5_csv(&[&r.e5_decoupled, &r.e5_routed]));
 }
+
+/// E7 (beyond the paper, #27): when tension stiffens. The table and the claim as a snapshot;
+/// the closed form against the numbers is `tests/tension_stiffens.rs`.
+#[test]
+fn e7_tension_stiffens() {
+    let r = report();
+    let rendered = paper::render_e7(&r.e7);
+    insta::assert_snapshot!("e7_tension_stiffens", rendered);
+    assert_committed(paper::E7_FILE, &rendered);
+    // The claim is in the report's list, and its verdict is the numbers'.
+    assert!(r.claims().any(|c| c == &r.e7.claim));
+    assert_eq!(r.e7.claim.verdict(), "holds", "{}", r.e7.claim.evidence);
+    // Every point of the map: the closed form at Q0 classifies it as the numbers do, and where
+    // the holes do not straddle the centre over a gap at least as wide as the hole radius,
+    // tension never softens anywhere in the workspace.
+    let (agree, total) = r.e7.map.closed_form_agreement();
+    let n = r.e7.map.axis.len();
+    let axis = &r.e7.map.axis;
+    let wide = (0..n * n).filter(|k| axis[k / n] + axis[k % n] >= paper::E7_MIN_GAP).count();
+    // Every point with the gap computed, and classified alike.
+    assert_eq!((agree, total), (wide, wide));
+    assert_eq!(wide, 8910);
+    for a in 0..n {
+        for b in 0..n {
+            let (d1, d2) = (r.e7.map.axis[a], r.e7.map.axis[b]);
+            if let Some(c) = r.e7.map.cell(a, b) {
+                if d1 * d2 <= 0.0 && d1 + d2 >= r.e7.map.radius {
+                    assert_eq!(c.workspace_class, paper::TensionEffect::Stiffens, "({d1}, {d2})");
+                }
+                if d1 * d2 > 0.0 {
+                    assert_ne!(c.workspace_class, paper::TensionEffect::Stiffens, "({d1}, {d2})");
+                }
+            }
+        }
+    }
+}

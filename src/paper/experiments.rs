@@ -69,3 +69,17 @@ pub const E5_MARGIN: f64 = 0.05;
 
 /// Points of E5's trade-off between the tension budget and the best `λ_min(K_fd)`.
 pub const E5_TRADEOFF_POINTS: usize = 9;
+
+/// E7 (beyond the paper, spec §10): the range of both `d1` and `d2` on the map, mm.
+pub const E7_RANGE_MM: [f64; 2] = [-10.0, 40.0];
+/// Points per axis of E7's map (0.5 mm apart, so `d1 = 0` and `d2 = 0` are on the grid).
+pub const E7_POINTS: usize = 101;
+/// Poses per axis over the joint limits `[−π/6, π/6]²` where E7 classifies `A_i` (odd, so Q0
+/// is one of them).
+pub const E7_POSES: usize = 5;
+/// The smallest gap `d1 + d2` between the hole planes on E7's map, m: below it the cables
+/// cross near the joint centre and the map leaves the cell out.
+pub const E7_MIN_GAP: f64 = 0.005;
+/// The off-centre geometry of one of CASPR's snake models (issue #27, spec §10): holes 6.6 mm
+/// below and 13.6 mm above the joint centre, `[d1, d2]`, m.
+pub const E7_OFF_CENTRE: [f64; 2] = [0.0066, 0.0136];

@@ -12,12 +12,14 @@
 mod arm;
 mod claim;
 mod claims;
+mod e7;
 mod experiments;
 mod patterns;
 mod planning;
 mod report;
 mod single_joint;
 mod table1;
+mod tension;
 
 pub use arm::{
     E4, E4Case, E4Joint, claims_e4, claims_e4_end, claims_e4_joints, e4, render_e4,
@@ -25,10 +27,11 @@ pub use arm::{
 };
 pub use claim::Claim;
 pub use claims::{claims_e1_e3, render_claims};
+pub use e7::{E7, E7Case, E7Cell, E7Map, e7, render_e7};
 pub use experiments::{
     E2_Q, E2_SAMPLES, E2_TORQUE, E3_POINTS, E3_RANGE, E3_TORQUE, E4_CASES, E4_F0,
-    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, PAPER_TABLE_2,
-    SINGLE_JOINT, TABLE_2_TORQUE,
+    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, E7_MIN_GAP,
+    E7_OFF_CENTRE, E7_POINTS, E7_POSES, E7_RANGE_MM, PAPER_TABLE_2, SINGLE_JOINT, TABLE_2_TORQUE,
 };
 pub use patterns::{
     LEAST_RANGE_AWAY, MAX_RISE, MAX_RISE_OVER_MIN_MOVE, NEAR_ZERO_MAX, NEAR_ZERO_SHARE,
@@ -36,13 +39,18 @@ pub use patterns::{
 };
 pub use planning::{E5, E5Row, e5, e5_csv, render_e5};
 pub use report::{
-    FIG_E5_FILE, FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR, ROBOT_DIR, Report,
+    E7_FILE, FIG_E5_FILE, FIG_E7_FILE, FIG4_FILE, FIG5_MAPS, FIG6_FILE, HeatMap, REPORT_DIR,
+    ROBOT_DIR, Report,
 };
 pub use single_joint::{
     E2Point, Table2Row, e2, e2_csv, e3, e3_csv, e3_with_progress, render_table_2,
     rms_relative_error, table_2,
 };
 pub use table1::table_1;
+pub use tension::{
+    HoleGeometry, TensionEffect, classify_q0, criterion_q0, eigenvalues, joint_geometry,
+    single_joint, tension_stiffness, zero_tolerance,
+};
 
 /// `x` with `decimals` digits after the point, `-0.000` printed as `0.000`.
 pub fn fixed(x: f64, decimals: usize) -> String {

@@ -12,6 +12,7 @@ use crate::routing::Routing;
 
 use super::arm::{E4, claims_e4_end, claims_e4_joints, e4, render_e4, render_routed_vs_decoupled};
 use super::claims::{Claim, claims_e1_e3, render_claims};
+use super::e7::{E7, e7, render_e7};
 use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE, E5_MARGIN};
 use super::planning::{E5, e5, e5_csv, render_e5};
 use super::single_joint::{
@@ -30,6 +31,10 @@ pub const FIG4_FILE: &str = "fig4_e2.svg";
 pub const FIG6_FILE: &str = "fig6_e4.svg";
 /// E5's trade-off figure (line plots: SVG).
 pub const FIG_E5_FILE: &str = "fig_e5_tradeoff.svg";
+/// E7's map of the sign of the controllable stiffness over `d1`, `d2` (a raster image: PNG).
+pub const FIG_E7_FILE: &str = "fig_e7_tension_stiffens.png";
+/// E7's report file.
+pub const E7_FILE: &str = "e7_tension_stiffens.md";
 
 /// One heat map of Fig. 5: its file, its title and the number of a sweep cell it shows.
 #[derive(Debug, Clone, Copy)]
@@ -99,6 +104,8 @@ pub struct Report {
     pub e5_decoupled: E5,
     /// E5, the routed model.
     pub e5_routed: E5,
+    /// E7 (beyond the paper): when tension stiffens, on joint 1's hole geometry.
+    pub e7: E7,
 }
 
 /// The E4 runs with their report file and heading, in the report's order.
@@ -147,6 +154,13 @@ impl Report {
             .collect();
         let e5_decoupled = e5(&robot, &routing, "decoupled")?;
         let e5_routed = e5(&robot, &routed, "routed")?;
+        let routing_file = robot_dir.join(crate::routing::ROUTING_FILE);
+        let text = std::fs::read_to_string(&routing_file).map_err(|source| {
+            crate::routing::RoutingError::Io { path: routing_file.clone(), source }
+        })?;
+        let template =
+            crate::routing::RoutingSpec::from_toml_str(&text, &routing_file.display().to_string())?;
+        let e7 = e7(&robot, &routing, &template)?;
         Ok(Report {
             robot,
             routing,
@@ -162,6 +176,7 @@ impl Report {
             claims_e4,
             e5_decoupled,
             e5_routed,
+            e7,
         })
     }
 
@@ -170,9 +185,9 @@ impl Report {
         [&self.e4_decoupled, &self.e4_routed, &self.e4_stable]
     }
 
-    /// Every claim of the report, E1–E3 then E4.
+    /// Every claim of the report, E1–E3, E4, then E7's.
     pub fn claims(&self) -> impl Iterator<Item = &Claim> {
-        self.claims_e1_e3.iter().chain(&self.claims_e4)
+        self.claims_e1_e3.iter().chain(&self.claims_e4).chain(std::iter::once(&self.e7.claim))
     }
 
     /// The report's text files, `(name in REPORT_DIR, content)`: the tables, the CSV data,
@@ -191,6 +206,7 @@ impl Report {
         files.push(("e5_decoupled.md", render_e5(&self.e5_decoupled)));
         files.push(("e5_routed.md", render_e5(&self.e5_routed)));
         files.push(("e5_tradeoff.csv", e5_csv(&[&self.e5_decoupled, &self.e5_routed])));
+        files.push((E7_FILE, render_e7(&self.e7)));
         files.push(("README.md", self.readme()));
         files
     }
@@ -271,7 +287,26 @@ impl Report {
         writeln!(r, "### Routed\n\n{}", render_e5(&self.e5_routed))?;
         writeln!(
             r,
-            "The best λ_min(K_fd) against the tension budget (data: `e5_tradeoff.csv`):\n\n![E5 trade-off]({FIG_E5_FILE})"
+            "The best λ_min(K_fd) against the tension budget (data: `e5_tradeoff.csv`):\n\n![E5 trade-off]({FIG_E5_FILE})\n"
+        )?;
+        self.write_e7(r)
+    }
+
+    fn write_e7(&self, r: &mut String) -> std::fmt::Result {
+        writeln!(r, "## E7 (beyond the paper): when tension stiffens\n")?;
+        writeln!(
+            r,
+            "Conclusion (1), \"the greater the cable tension, the greater the joint stiffness\", is a property of the hole geometry. Along the joint's tension coordinate λ (f = f_p + λ N, eq. 22–23) the joint stiffness changes at the rate A_i = Σ_c N_c H_c (H_c = ∂²L_c/∂q², spec §10). At the straight pose Q0 every cable's Hessian is −d1·d2/(d1 + d2)·I, whatever the hole radius r and angle, so"
+        )?;
+        writeln!(r, "\n    A_i(Q0) = −d1·d2/(d1 + d2) · (Σ_c N_c) · I₂\n")?;
+        writeln!(
+            r,
+            "(derivation: `src/paper/tension.rs`): tension stiffens the straight joint iff d1·d2 < 0 (the joint centre outside the gap between the hole planes), leaves it alone iff d1·d2 = 0 (a hole plane through the centre: the paper's d2 ≈ 0, cdhrm5's fitted d2 = 0), and softens it iff d1·d2 > 0 (holes below and above the centre). At Q0 A_i is never indefinite; away from it the pose and r matter, so the map classifies A_i over the workspace too. The off-centre geometry is CASPR's snake's hole planes (6.6 mm below, 13.6 mm above the centre) with cdhrm5's cables and hole radius: the rest of that model (its radius, cables, pose and load) is not in this repository, so its 81.7 → 75.8 N m/rad is not reproduced here, only its sign. Joint 1 alone, the other joints straight; K at Q0 holds τ = [0.3, 0.3] N m with f ∈ [20, 600] N. File: `{E7_FILE}`.\n"
+        )?;
+        writeln!(r, "{}", render_e7(&self.e7))?;
+        writeln!(
+            r,
+            "Sign of A_i over the workspace, d2 against d1 at cdhrm5's r; the closed form's boundary at Q0 (d1 = 0, d2 = 0) dashed, the gap d1 + d2 below the map's minimum in grey:\n\n![E7 map]({FIG_E7_FILE})"
         )
     }
 }

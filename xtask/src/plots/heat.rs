@@ -9,23 +9,23 @@ use plotters::prelude::*;
 use sinew::indicators::{SweepCell, SweepMaps};
 use sinew::paper::fixed;
 
-use super::axes::Axes;
+use super::axes::{Axes, Chart};
 use super::layout::{Anchor, Layout, Rect, Target, extent, nice_ticks, register_font, text};
 use crate::DynResult;
 
 /// Side of one grid cell, pixels.
-const CELL: i32 = 4;
+pub(super) const CELL: i32 = 4;
 /// Width of the colour bar, its distance from the map, and the length of its ticks, pixels.
 const BAR_WIDTH: i32 = 24;
 const BAR_GAP: i32 = 40;
 const TICK: i32 = 5;
 /// Font sizes (plotters' size, the font's height in pixels): tick labels, title.
-const SIZE: f64 = 16.0;
-const TITLE: f64 = 22.0;
+pub(super) const SIZE: f64 = 16.0;
+pub(super) const TITLE: f64 = 22.0;
 /// Space kept free at the canvas' edges, pixels.
-const PAD: i32 = 10;
+pub(super) const PAD: i32 = 10;
 /// Grey of the cells where the torque cannot be held.
-const INFEASIBLE: RGBColor = RGBColor(200, 200, 200);
+pub(super) const INFEASIBLE: RGBColor = RGBColor(200, 200, 200);
 
 /// One heat map of Fig. 5 with its colour bar: `value(cell)` over `q1` (x) and `q2` (y), each
 /// grid cell a [`CELL`] × [`CELL`] square, grey where the torque cannot be held. Returns where
@@ -119,8 +119,9 @@ pub fn heat_map(
     layout.check(title)
 }
 
-/// The map's cells and its axes.
-fn draw<DB: DrawingBackend>(
+/// The map's cells (`values[a · n + b]`: column `a` from the left, row `b` from the bottom,
+/// [`INFEASIBLE`] where `None`) and its axes; returns the chart that maps data into `plot`.
+pub(super) fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     values: &[Option<f64>],
     n: usize,
@@ -128,7 +129,7 @@ fn draw<DB: DrawingBackend>(
     colour: impl Fn(f64) -> RGBColor,
     layout: &mut Layout,
     axes: &Axes<'_>,
-) -> DynResult<()>
+) -> DynResult<Chart<DB>>
 where
     DB::ErrorType: 'static,
 {
@@ -141,12 +142,11 @@ where
             root.draw(&Rectangle::new([(x, y), (x + CELL, y + CELL)], fill.filled()))?;
         }
     }
-    axes.draw(root, plot, layout)?;
-    Ok(())
+    axes.draw(root, plot, layout)
 }
 
 /// The RGB buffer as an 8-bit RGB PNG.
-fn write_png(path: &Path, (width, height): (u32, u32), rgb: &[u8]) -> DynResult<()> {
+pub(super) fn write_png(path: &Path, (width, height): (u32, u32), rgb: &[u8]) -> DynResult<()> {
     let file = std::io::BufWriter::new(std::fs::File::create(path)?);
     let mut encoder = png::Encoder::new(file, width, height);
     encoder.set_color(png::ColorType::Rgb);

@@ -1,6 +1,6 @@
 //! The report's figures, all drawn with plotters and the embedded DejaVu Sans
 //! (`xtask/assets/`, through plotters' `ab_glyph` feature: no system font): the line plots
-//! (Fig. 4, E5) and the ellipses (Fig. 6) as SVG, the heat maps of Fig. 5 as PNG.
+//! (Fig. 4, E5) and the ellipses (Fig. 6) as SVG, the heat maps of Fig. 5 and E7's map as PNG.
 //!
 //! Every text is placed from the font's metrics and every legend where no curve is; each figure
 //! returns its [`layout::Layout`] and fails rather than be written with a text outside its canvas or
@@ -9,7 +9,7 @@
 //! - [`layout`]: the font, text extents, round ticks, the layout and its check;
 //! - [`axes`]: a panel's frame, grid, ticks, labels and title;
 //! - [`legend`]: legends and where they go;
-//! - [`lines`], [`heat`], [`ellipses`]: the figures.
+//! - [`lines`], [`heat`], [`ellipses`], [`sign_map`]: the figures.
 
 mod axes;
 mod ellipses;
@@ -17,10 +17,12 @@ mod heat;
 mod layout;
 mod legend;
 mod lines;
+mod sign_map;
 
 pub use ellipses::fig6;
 pub use heat::heat_map;
 pub use lines::{fig_e5, fig4};
+pub use sign_map::fig_e7;
 
 #[cfg(test)]
 mod tests {
@@ -50,6 +52,8 @@ mod tests {
                 (paper::FIG6_FILE.to_owned(), fig6(&e4, &path(paper::FIG6_FILE)).unwrap()),
                 (paper::FIG_E5_FILE.to_owned(), fig_e5(&e5, &path(paper::FIG_E5_FILE)).unwrap()),
             ];
+            let e7 = fig_e7(&report.e7, &path(paper::FIG_E7_FILE)).unwrap();
+            out.push((paper::FIG_E7_FILE.to_owned(), e7));
             for map in paper::FIG5_MAPS {
                 let layout = heat_map(&report.e3, map.title, map.value, &path(map.file)).unwrap();
                 out.push((map.file.to_owned(), layout));
