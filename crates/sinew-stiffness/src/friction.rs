@@ -18,7 +18,7 @@
 use faer::MatRef;
 use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
-use crate::colmajor::ColMajor;
+use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
 
 /// How the segment tensions of a sticking cable were left (spec §9): the distribution of the
@@ -176,6 +176,12 @@ impl FrictionStiffnessData {
         self.controllable.as_mut_slice().fill(0.0);
         self.inherent.as_mut_slice().fill(0.0);
         Ok(())
+    }
+
+    /// The inherent part's upper triangle copied onto its lower one.
+    pub(crate) fn mirror_inherent(&mut self) {
+        let inherent = &mut self.inherent;
+        mirror_upper(0..self.dof, |i, j| *inherent.at_mut(i, j) = inherent.at(j, i));
     }
 
     /// `K = K_c + K_i`, its symmetric part and the norm of its skew part; then the regime.

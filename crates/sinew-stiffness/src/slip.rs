@@ -97,12 +97,7 @@ pub fn slip_stiffness(
             }
         }
     }
-    let n = out.dof;
-    for j in 0..n {
-        for i in j + 1..n {
-            *out.inherent.at_mut(i, j) = out.inherent.at(j, i);
-        }
-    }
+    out.mirror_inherent();
     // Pass 2, the cables with friction: the pieces in series.
     let ea = axial_rigidity(routing);
     let j_tilde = friction.effective_jacobian()?;

@@ -77,12 +77,7 @@ pub fn stick_stiffness(
             }
         }
     }
-    let n = out.dof;
-    for j in 0..n {
-        for i in j + 1..n {
-            *out.inherent.at_mut(i, j) = out.inherent.at(j, i);
-        }
-    }
+    out.mirror_inherent();
     out.finish(FrictionRegime::Stick(history));
     Ok(())
 }
