@@ -110,7 +110,13 @@ impl SlipTorque<'_> {
                 top += (l[s] - l0[s]) + t0[s] * l0[s] / ea;
                 bottom += w[s] * l0[s] / ea;
             }
-            let t_0 = top / bottom;
+            // A cable without friction: eq. 13's spring on the whole cable (today's model).
+            let t_0 = if self.model.friction_coefficients()[c] == 0.0 {
+                let moved: f64 = (1..l.len()).map(|s| l[s] - l0[s]).sum();
+                t0[0] + self.routing.cables()[c].stiffness * moved
+            } else {
+                top / bottom
+            };
             for (i, t) in tau.iter_mut().enumerate() {
                 *t -= t_0 * j_tilde[(c, i)];
             }
@@ -123,30 +129,52 @@ impl SlipTorque<'_> {
 fn slip_stiffness_matches_the_central_difference_of_the_torque() {
     for (case, robot, routing, [tol, _]) in cases() {
         let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
-        let mut out = FrictionStiffnessData::new(&model);
+        check_slip(&case, &robot, &routing, &model, tol);
+    }
+}
+
+/// A routing whose first cable has no friction (today's eq. 13 spring) among cables with μ =
+/// 0.2 and 0.05: each cable takes its own path.
+#[test]
+fn slip_stiffness_with_a_frictionless_cable_among_others() {
+    let chain = RandomChain::new(3, 3);
+    let robot = chain.robot();
+    let mut spec = chain.explicit_spec(3);
+    for (c, cable) in spec.cables.iter_mut().enumerate() {
+        cable.friction_coefficient = Some([0.0, 0.2, 0.05][c % 3]);
+    }
+    let routing = chain.routing(&robot, &spec);
+    let model = FrictionModel::new(&routing);
+    assert_eq!(&model.friction_coefficients()[..3], &[0.0, 0.2, 0.05]);
+    // Measured 1.6e-9.
+    check_slip("mixed μ", &robot, &routing, &model, 1e-8);
+}
+
+fn check_slip(case: &str, robot: &Robot, routing: &Routing, model: &FrictionModel, tol: f64) {
+    {
+        let mut out = FrictionStiffnessData::new(model);
         for slip in [Slip::Pull, Slip::Release] {
             let (mut acc, mut skew) = ((0.0, 0.0), 0.0_f64);
-            for (k, q) in random_qs(&robot, 11, 3).iter().enumerate() {
-                let mut at = evaluate(&robot, &routing, &model, q);
+            for (k, q) in random_qs(robot, 11, 3).iter().enumerate() {
+                let mut at = evaluate(robot, routing, model, q);
                 assert!(
                     routing.cables().iter().enumerate().all(|(c, _)| {
-                        !at.friction.kinked(&model, c).unwrap().iter().any(|&b| b)
+                        !at.friction.kinked(model, c).unwrap().iter().any(|&b| b)
                     })
                 );
-                compute_capstan_weights(&model, &mut at.friction, slip).unwrap();
-                let t = tensions(&routing, k as u64);
-                slip_stiffness(&model, &routing, &at.geometry, &at.friction, slip, &t, &mut out)
+                compute_capstan_weights(model, &mut at.friction, slip).unwrap();
+                let t = tensions(routing, k as u64);
+                slip_stiffness(model, routing, &at.geometry, &at.friction, slip, &t, &mut out)
                     .unwrap();
                 assert_eq!(out.regime(), Some(FrictionRegime::Slip(slip)));
                 let reference = (0..routing.cable_count())
                     .map(|c| {
-                        let l = at.friction.lengths(&model, c).unwrap().to_vec();
-                        let w = at.friction.weights(&model, c).unwrap();
+                        let l = at.friction.lengths(model, c).unwrap().to_vec();
+                        let w = at.friction.weights(model, c).unwrap();
                         (l, w.iter().map(|w| t[c] * w).collect())
                     })
                     .collect();
-                let torque =
-                    SlipTorque { robot: &robot, routing: &routing, model: &model, slip, reference };
+                let torque = SlipTorque { robot, routing, model, slip, reference };
                 // The model reproduces the tensions at q0.
                 let tau0 = torque.torque(q);
                 let mut direct = vec![0.0; q.len()];
@@ -176,7 +204,7 @@ fn slip_stiffness_matches_the_central_difference_of_the_torque() {
                 assert!((s.sqrt() - out.skew_norm().unwrap()).abs() <= 1e-12 * s.sqrt());
                 skew = skew.max(out.skew_norm().unwrap() / acc.1);
             }
-            report(&case, &format!("K_slip {slip:?}"), acc, tol);
+            report(case, &format!("K_slip {slip:?}"), acc, tol);
             println!("{case}: K_slip {slip:?}: |skew part|_F / max |K| up to {skew:.2e}");
             // Friction makes it non-symmetric by far more than rounding.
             assert!(skew > 1e-6, "{case}: {slip:?}: K_slip is symmetric ({skew:.1e})");
