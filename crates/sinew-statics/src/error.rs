@@ -256,6 +256,21 @@ pub enum StaticsError {
         /// Why it stopped.
         stop: SolverStop,
     },
+    /// In a slip regime with friction, no actuator tension keeps every segment of the cable
+    /// within its limits: the capstan ratio `max_s w_s / min_s w_s` along it exceeds
+    /// `f_max / f_min` ([`crate::actuator_limits`]).
+    #[error(
+        "cable {cable}: no actuator tension keeps every segment within [{}, {}] N: the capstan ratio along it is {}",
+        Compact(.limits[0]), Compact(.limits[1]), Compact(*.ratio)
+    )]
+    EmptyActuatorInterval {
+        /// The cable (0-based).
+        cable: usize,
+        /// Its `[f_min, f_max]`, N.
+        limits: [f64; 2],
+        /// `max_s w_s / min_s w_s`.
+        ratio: f64,
+    },
     /// An error of the robot model (sizes, workspace).
     #[error(transparent)]
     Robot(#[from] sinew_robot::RobotError),
@@ -274,7 +289,8 @@ impl StaticsError {
         match self {
             StaticsError::Infeasible { .. }
             | StaticsError::NoEquilibrium(_)
-            | StaticsError::LevelsInfeasible(_) => ErrorKind::Infeasible,
+            | StaticsError::LevelsInfeasible(_)
+            | StaticsError::EmptyActuatorInterval { .. } => ErrorKind::Infeasible,
             StaticsError::NonFiniteTorque { .. }
             | StaticsError::LevelsUnavailable(_)
             | StaticsError::NotBalanced(_)

@@ -12,6 +12,10 @@
 //!   equilibrium set `f = f_p + N λ` and its polytope ([`EquilibriumSet`]), and the named
 //!   tension policies over it ([`TensionPolicy`]: least total tension, least 2-norm, farthest
 //!   from the limits), solved with clarabel;
+//! - with friction at the holes, the slip regimes' statics on the effective Jacobian `J̃`: the
+//!   torque ([`slip_torques`]), the actuator-tension limits ([`actuator_limits`]), the
+//!   equilibrium set in the actuator tensions ([`slip_equilibrium_set`]) and the dead band
+//!   ([`dead_band`]) (spec §9);
 //! - all of it for a robot and its routing in one call ([`ArmStatics`], [`TensionChoice`]).
 //!
 //! Infeasible loads are typed outcomes naming the joint — [`StaticsError::Infeasible`] with an
@@ -64,6 +68,7 @@ mod levels;
 mod policy;
 mod refusal;
 mod set_block;
+mod slip;
 mod three_cable;
 
 pub use arm::{ArmStatics, ArmStaticsData};
@@ -81,6 +86,7 @@ pub use joint_end::{
 pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
 pub use refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
 pub use set_block::SET_RANK_TOLERANCE;
+pub use slip::{actuator_limits, dead_band, slip_equilibrium_set, slip_torques};
 
 use faer::MatRef;
 

@@ -81,6 +81,23 @@ pub enum StiffnessError {
         /// Cables of the arm the workspace was made for.
         workspace_cables: usize,
     },
+    /// The stick regime asked of a cable without friction (μ = 0): it has no band, so it
+    /// cannot stick (spec §9).
+    #[error("the stick regime needs friction: cable {cable} has μ = 0 (no band to stick in)")]
+    StickWithoutFriction {
+        /// The cable (0-based).
+        cable: usize,
+    },
+    /// The friction workspace holds the capstan weights of another slip regime, or none.
+    #[error(
+        "the friction workspace holds the capstan weights of {computed:?}, not of {needs:?}: run compute_capstan_weights for {needs:?} first"
+    )]
+    WrongCapstanWeights {
+        /// The regime needed.
+        needs: sinew_routing::Slip,
+        /// The regime whose weights it holds (`None`: none).
+        computed: Option<sinew_routing::Slip>,
+    },
     /// An error of the statics itself (tensions, torques, unsupported routing).
     #[error(transparent)]
     Statics(StaticsError),
@@ -108,7 +125,9 @@ impl StiffnessError {
             | StiffnessError::WorkspaceMismatch { .. } => ErrorKind::Numerical,
             StiffnessError::DimensionMismatch { .. }
             | StiffnessError::InvalidDirection { .. }
-            | StiffnessError::StageMissing { .. } => ErrorKind::Input,
+            | StiffnessError::StageMissing { .. }
+            | StiffnessError::StickWithoutFriction { .. }
+            | StiffnessError::WrongCapstanWeights { .. } => ErrorKind::Input,
             StiffnessError::Statics(e) => e.kind(),
             StiffnessError::Robot(e) => e.kind(),
             StiffnessError::Routing(e) => e.kind(),

@@ -8,6 +8,9 @@
 //! - end compliance and stiffness `C_x = J_x (K_q + K_W)⁻¹ J_xᵀ`, `K_x = C_x⁻¹`
 //!   ([`end_compliance`], [`end_stiffness`]), with unstable equilibria and rank-deficient
 //!   Jacobians as typed outcomes;
+//! - with friction at the holes (spec §9): the stick regime's `K_stick` ([`stick_stiffness`])
+//!   and the slip regimes' `K = −∂τ/∂Q` with the slip direction held ([`slip_stiffness`]),
+//!   into a [`FrictionStiffnessData`];
 //! - the whole pipeline `Q → K_x` for a robot and its routing: the model [`ArmStiffness`] and
 //!   its workspace [`ArmStiffnessData`].
 //!
@@ -35,9 +38,12 @@ mod ellipsoid;
 mod end;
 mod end_data;
 mod error;
+mod friction;
 mod inherent;
 mod joint;
 mod outcome;
+mod slip;
+mod stick;
 mod structured;
 
 pub use arm::ArmStiffness;
@@ -46,5 +52,8 @@ pub use ellipsoid::StiffnessEllipsoid;
 pub use end::{end_compliance, end_stiffness, stability_margin};
 pub use end_data::{END_RANK_TOLERANCE, EndStiffnessData, compliance_inverse, has_full_rank};
 pub use error::StiffnessError;
+pub use friction::{FrictionRegime, FrictionStiffnessData, History};
 pub use joint::{joint_block, joint_stiffness, stiffness_slope};
 pub use outcome::{Outcome, OutcomeNote};
+pub use slip::slip_stiffness;
+pub use stick::stick_stiffness;

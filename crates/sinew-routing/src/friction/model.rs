@@ -179,6 +179,11 @@ impl FrictionModel {
         Ok(self)
     }
 
+    /// Number of revolute joints (the columns of `J_s`, `J̃`).
+    pub fn dof(&self) -> usize {
+        self.dof
+    }
+
     /// Number of cables.
     pub fn cable_count(&self) -> usize {
         self.cables.len()

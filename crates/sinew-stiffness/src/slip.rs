@@ -1,0 +1,148 @@
+//! The slip regimes' joint stiffness (spec §9, #27): every hole slides the same way, the pieces
+//! of each cable in series, their tensions tied by the capstan ratio.
+//!
+//! # Derivation
+//! Cable `c` (index dropped), friction segments `s = 0 … H−1`, segment 0 the free length
+//! (`ℓ_0 = ℓ_free`, `J_0 = 0`); weights `w_s(Q)` of the regime (`w_0 = 1`), their gradients
+//! `∇w_s = ∂w_s/∂Q` (`sinew_routing::compute_capstan_weights`). The segment tensions are
+//! `T_s = T_0 w_s(Q)` and the torque is `τ = −T_0 J̃ᵀ`, `J̃ = Σ_s w_s J_s`.
+//!
+//! *Elasticity (the one model of every regime).* Each piece is a spring of compliance
+//! `c_s = ℓ_s / (E A)` (`ℓ_s` at the pose; the free length's with the actuator held). Every
+//! hole slides, so material flows between the pieces and only the cable's total material is
+//! fixed: an increment `δQ` changes the pieces' lengths by `δℓ_s = J_s δQ` (`δℓ_0 = 0`) and
+//! their material by `δλ_s` with `Σ_s δλ_s = 0`, while each piece's stretch follows its
+//! tension, `δℓ_s − δλ_s = c_s δT_s`. Summed over the pieces:
+//!
+//! ```text
+//! J_c δQ = Σ_s c_s δT_s = Σ_s c_s (w_s δT_0 + T_0 ∇w_s δQ)          (J_c = Σ_s J_s)
+//! ⇒  ∂T_0/∂Q = (J_c − T_0 g) / C̃,     C̃ = Σ_s c_s w_s,   g = Σ_s c_s ∇w_s   (rows, 1 × dof)
+//! ```
+//!
+//! *Stiffness.* `K = −∂τ/∂Q = J̃ᵀ ∂T_0/∂Q + T_0 ∂J̃ᵀ/∂Q`, with
+//! `∂J̃ᵀ/∂Q = Σ_s (w_s H_s + J_sᵀ ∇w_s)` (entry `(i, j)`: `∂J̃_i/∂q_j`). Summed over the
+//! cables and split as the frictionless `K` is:
+//!
+//! ```text
+//! K_slip = Σ_c T_0 [ Σ_s w_s H_s + Σ_s J_sᵀ ∇w_s − J̃ᵀ g / C̃ ]   +   Σ_c J̃ᵀ J_c / C̃
+//!                         (controllable: ∝ T_0)                       (inherent)
+//! ```
+//!
+//! It is not symmetric (`J̃ ≠ J_c`, and the weights move with `Q`): the workspace reports its
+//! symmetric part and the norm of its skew part. It is the stiffness for motions that keep
+//! every hole sliding the same way, with the slip direction held (the weights stay those of
+//! the regime); a motion that reverses a hole's slip makes it stick (spec §9's directional
+//! response). At a kinked hole (`θ ≈ 0`, `sinew_routing::WRAP_KINK`) `∇θ = 0` is used (the
+//! least-norm subgradient), so there `K` is one element of a set, not a derivative.
+//!
+//! *μ → 0⁺.* Then `w_s → 1`, `∇w_s → 0`, `J̃ → J_c`, `C̃ → (ℓ_free + L_c(Q))/(E A)`, and
+//! `K_slip → Σ_c T_0 H_c + J_cᵀ E A/(ℓ_free + L_c(Q)) J_c`: eq. 14 with eq. 13's `k_c` taken at
+//! the pose instead of at `Q0`. The two differ by
+//! `k_c (L_c(Q0) − L_c(Q)) / (ℓ_free + L_c(Q))` relative to `k_c`: millimetres against metres on
+//! cdhrm5. **At μ = 0 exactly** a cable takes today's path, eq. 13's `k_c`
+//! (`sinew_routing::Cable::stiffness`), summed in today's order: with every μ = 0 the result is
+//! [`crate::joint_stiffness`]'s bit for bit.
+
+use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData, Slip};
+
+use crate::error::StiffnessError;
+use crate::friction::{
+    FrictionRegime, FrictionStiffnessData, add_segment_hessian, axial_rigidity, check_weights,
+};
+
+/// The joint stiffness of the slip regime `slip` at the actuator tensions `actuator` (m, N),
+/// with the slip direction held, into `out` ([`FrictionStiffnessData::stiffness`], its two
+/// parts, its symmetric part and the norm of its skew part).
+///
+/// Needs the cable geometry with Hessians (`geometry`), and the friction geometry and the
+/// capstan weights of `slip` at the same `Q` in `friction`. No allocation.
+///
+/// # Math
+/// Module docs of `slip.rs` (the derivation):
+/// `K_slip = Σ_c T_0 [Σ_s w_s H_s + Σ_s J_sᵀ ∇w_s − J̃ᵀ g / C̃] + Σ_c J̃ᵀ J_c / C̃`, with
+/// `c_s = ℓ_s/(E A)`, `C̃ = Σ_s c_s w_s`, `g = Σ_s c_s ∇w_s`; a cable with μ = 0 takes today's
+/// `T_0 H_c + k_c J_cᵀ J_c` (eq. 13–14). Cost `O(Σ_c Σ_s |dofs_s|² + Σ_c |dofs_c|²)`.
+///
+/// # Errors
+/// [`StiffnessError::WrongCapstanWeights`] when `friction` holds the other regime's weights or
+/// none; [`StiffnessError::DimensionMismatch`]; routing errors.
+pub fn slip_stiffness(
+    model: &FrictionModel,
+    routing: &Routing,
+    geometry: &RoutingData,
+    friction: &FrictionData,
+    slip: Slip,
+    actuator: &[f64],
+    out: &mut FrictionStiffnessData,
+) -> Result<(), StiffnessError> {
+    out.start(model, routing, actuator)?;
+    check_weights(friction, slip)?;
+    let mu = model.friction_coefficients();
+    let j_c = geometry.jacobian()?;
+    // Pass 1, every cable: Σ_s T_0 w_s H_s (w_s = 1 exactly at μ = 0: today's Σ f_c H_c in its
+    // order); the μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal, then mirrored.
+    for (c, &t_0) in actuator.iter().enumerate() {
+        let weights = friction.weights(model, c)?;
+        for (s, &w) in weights.iter().enumerate().skip(1) {
+            add_segment_hessian(model, routing, geometry, (c, s), t_0 * w, &mut out.controllable)?;
+        }
+        if mu[c] == 0.0 {
+            let cable = &routing.cables()[c];
+            let k = cable.stiffness;
+            for j in cable.dofs.clone() {
+                let kj = k * j_c[(c, j)];
+                for i in cable.dofs.start..=j {
+                    *out.inherent.at_mut(i, j) += kj * j_c[(c, i)];
+                }
+            }
+        }
+    }
+    out.mirror_inherent();
+    // Pass 2, the cables with friction: the pieces in series.
+    let ea = axial_rigidity(routing);
+    let j_tilde = friction.effective_jacobian()?;
+    for (c, &t_0) in actuator.iter().enumerate() {
+        if mu[c] == 0.0 {
+            continue;
+        }
+        let (lengths, weights) = (friction.lengths(model, c)?, friction.weights(model, c)?);
+        // The cable's DOFs (J_c, J̃) and those its last weight's gradient reaches (the union of
+        // every ∇w_s's).
+        let rows = routing.cables()[c].dofs.clone();
+        let reach = friction.weight_gradient(model, c, lengths.len() - 1)?.dofs;
+        let cols = if reach.is_empty() {
+            rows.clone()
+        } else {
+            rows.start.min(reach.start)..rows.end.max(reach.end)
+        };
+        out.gradient[cols.clone()].fill(0.0);
+        let mut series = 0.0;
+        for (s, (&l, &w)) in lengths.iter().zip(weights).enumerate() {
+            let c_s = l / ea;
+            series += c_s * w;
+            let grad_w = friction.weight_gradient(model, c, s)?;
+            for (g, d) in grad_w.values.iter().zip(grad_w.dofs.clone()) {
+                out.gradient[d] += c_s * g;
+            }
+            // T_0 J_sᵀ ∇w_s.
+            let j_s = friction.segment_jacobian(model, c, s)?;
+            for (g, j) in grad_w.values.iter().zip(grad_w.dofs.clone()) {
+                let tg = t_0 * g;
+                for (v, i) in j_s.values.iter().zip(j_s.dofs.clone()) {
+                    *out.controllable.at_mut(i, j) += v * tg;
+                }
+            }
+        }
+        // J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
+        for j in cols.clone() {
+            let (a, b) = (j_c[(c, j)] / series, t_0 * out.gradient[j] / series);
+            for i in rows.clone() {
+                let jt = j_tilde[(c, i)];
+                *out.inherent.at_mut(i, j) += jt * a;
+                *out.controllable.at_mut(i, j) -= jt * b;
+            }
+        }
+    }
+    out.finish(FrictionRegime::Slip(slip));
+    Ok(())
+}

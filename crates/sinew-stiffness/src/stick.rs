@@ -1,0 +1,83 @@
+//! The stick regime's joint stiffness (spec §9, #27): no hole slides, each segment a spring of
+//! its own.
+
+use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData};
+
+use crate::error::StiffnessError;
+use crate::friction::{
+    FrictionRegime, FrictionStiffnessData, History, add_segment_hessian, axial_rigidity,
+    check_weights,
+};
+
+/// The joint stiffness of the stick regime after `history`, at the actuator tensions
+/// `actuator` (m, N), into `out` ([`FrictionStiffnessData::stiffness`], its two parts, its
+/// symmetric part; the skew norm is 0 up to rounding).
+///
+/// Needs the cable geometry with Hessians (`geometry`), the friction geometry at the same `Q`
+/// and, for a [`History::Pull`] or [`History::Release`], that regime's capstan weights in
+/// `friction` ([`sinew_routing::compute_capstan_weights`]). No allocation.
+///
+/// # Math
+/// No hole slides: each piece of cable keeps its material, so each is a spring of its own,
+/// `k_s = E A / ℓ_s(Q)` (the free length, `J_0 = 0`, no longer adds compliance). The segment
+/// tensions are those the history left, `T_s = T_0 w_s` (`w_s` the pull or release weights at
+/// the pose, or 1 for [`History::Equal`]); `τ = −Σ_s T_s J_sᵀ`, and with `δT_s = k_s J_s δQ`:
+///
+/// ```text
+/// K_stick = Σ_c [ Σ_s T_{c,s} H_{c,s}  +  Σ_s J_{c,s}ᵀ (E A / ℓ_{c,s}(Q)) J_{c,s} ]
+///              (controllable)            (inherent)
+/// ```
+///
+/// symmetric (both sums are, and the inherent part is accumulated on one triangle and mirrored),
+/// affine in the actuator tensions for a given history. At equal tensions it is ⪰ the
+/// frictionless `K` with the cable's spring `E A/(ℓ_free + L_c(Q))`, by Cauchy–Schwarz:
+/// `(J_c δQ)² = (Σ_s √c_s · √k_s J_s δQ)² ≤ (Σ_s c_s)(Σ_s k_s (J_s δQ)²)`, `c_s = 1/k_s`,
+/// the free length's `c_0 = ℓ_free/(E A)` included. It is the tangent while every hole stays
+/// inside its band (spec §9: below the stick load limit).
+///
+/// # Errors
+/// [`StiffnessError::StickWithoutFriction`] for a cable with μ = 0 (no band: it cannot stick);
+/// [`StiffnessError::WrongCapstanWeights`] when `friction` holds the other regime's weights (or
+/// none) for a pull or release history; [`StiffnessError::DimensionMismatch`]; routing errors
+/// (geometry not computed, workspaces of another routing).
+pub fn stick_stiffness(
+    model: &FrictionModel,
+    routing: &Routing,
+    geometry: &RoutingData,
+    friction: &FrictionData,
+    history: History,
+    actuator: &[f64],
+    out: &mut FrictionStiffnessData,
+) -> Result<(), StiffnessError> {
+    out.start(model, routing, actuator)?;
+    if let Some(cable) = model.friction_coefficients().iter().position(|&mu| mu <= 0.0) {
+        return Err(StiffnessError::StickWithoutFriction { cable });
+    }
+    if let Some(slip) = history.slip() {
+        check_weights(friction, slip)?;
+    }
+    let ea = axial_rigidity(routing);
+    for (c, &t_0) in actuator.iter().enumerate() {
+        let lengths = friction.lengths(model, c)?;
+        let weights = match history {
+            History::Equal => None,
+            History::Pull | History::Release => Some(friction.weights(model, c)?),
+        };
+        for s in 1..lengths.len() {
+            let t_s = weights.map_or(t_0, |w| t_0 * w[s]);
+            add_segment_hessian(model, routing, geometry, (c, s), t_s, &mut out.controllable)?;
+            // J_sᵀ k_s J_s on and above the diagonal (mirrored below once every cable is in).
+            let j_s = friction.segment_jacobian(model, c, s)?;
+            let k_s = ea / lengths[s];
+            for (jj, j) in j_s.dofs.clone().enumerate() {
+                let kj = k_s * j_s.values[jj];
+                for (ii, i) in j_s.dofs.clone().enumerate().take(jj + 1) {
+                    *out.inherent.at_mut(i, j) += kj * j_s.values[ii];
+                }
+            }
+        }
+    }
+    out.mirror_inherent();
+    out.finish(FrictionRegime::Stick(history));
+    Ok(())
+}
