@@ -26,6 +26,10 @@ pub(crate) struct Pencil {
     pub(crate) a0: Mat<f64>,
     pub(crate) ai: Vec<Mat<f64>>,
     pub(crate) j_x: Mat<f64>,
+    /// Scratch: one column of `N` as cable weights.
+    pub(crate) weights: Vec<f64>,
+    /// Scratch: `K_W`.
+    pub(crate) k_w: Mat<f64>,
 }
 
 /// The end quantities at a point where `A ≻ 0`.
@@ -38,6 +42,17 @@ pub(crate) struct End {
 }
 
 impl Pencil {
+    /// A pencil with no buffers yet ([`crate::Planner`] fills it).
+    pub(crate) fn empty() -> Pencil {
+        Pencil {
+            a0: Mat::zeros(0, 0),
+            ai: Vec::new(),
+            j_x: Mat::zeros(0, 0),
+            weights: Vec::new(),
+            k_w: Mat::zeros(0, 0),
+        }
+    }
+
     /// `A(λ)`, symmetrised.
     pub(crate) fn at(&self, lambda: &[f64]) -> Mat<f64> {
         let n = self.a0.nrows();

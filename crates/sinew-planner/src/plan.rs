@@ -37,12 +37,19 @@ pub struct PlannerData {
     /// The last interior-point plan's active rows, with the number of rows of its frame (the
     /// warm start's first active set when this frame has as many).
     active: Option<(usize, Vec<usize>)>,
+    /// The last plan's pencil, its buffers reused by the next.
+    pencil: Option<Pencil>,
 }
 
 impl PlannerData {
     /// A workspace for `planner`.
     pub fn new(planner: &Planner) -> PlannerData {
-        PlannerData { stiffness: ArmStiffnessData::new(&planner.arm), previous: None, active: None }
+        PlannerData {
+            stiffness: ArmStiffnessData::new(&planner.arm),
+            previous: None,
+            active: None,
+            pencil: None,
+        }
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
@@ -140,7 +147,8 @@ impl Planner {
                 (set, least_total)
             }
         };
-        let pencil = self.pencil(sd, &set)?;
+        let mut pencil = data.pencil.take().unwrap_or_else(Pencil::empty);
+        self.fill_pencil(sd, &set, &mut pencil)?;
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
         let previous = data.previous.take();
@@ -198,6 +206,7 @@ impl Planner {
                 )?
             }
         };
+        data.pencil = Some(pencil);
         let plan = self.answer(
             &mut data.stiffness,
             &set,
@@ -408,33 +417,63 @@ impl Planner {
     }
 
     /// `A_0` and the `A_i` at the pose of `sd` (after a tension stage there: `K_i` and `K_W`).
+    #[cfg(test)]
     pub(crate) fn pencil(
         &self,
         sd: &mut ArmStiffnessData,
         set: &EquilibriumSet,
     ) -> Result<Pencil, PlanError> {
+        let mut pencil = Pencil::empty();
+        self.fill_pencil(sd, set, &mut pencil)?;
+        Ok(pencil)
+    }
+
+    /// [`Self::pencil`] into `pencil`, reusing its buffers (a plan's pencil is kept in its
+    /// workspace: re-planning along a trajectory allocates none of it again).
+    pub(crate) fn fill_pencil(
+        &self,
+        sd: &mut ArmStiffnessData,
+        set: &EquilibriumSet,
+        pencil: &mut Pencil,
+    ) -> Result<(), PlanError> {
         let routing = self.arm.routing();
         let dof = self.arm.dof();
-        let mut a0 = Mat::<f64>::zeros(dof, dof);
-        sd.cables.add_weighted_hessians(routing, set.particular(), a0.as_mut())?;
-        let k_inherent = sd.k_inherent().to_owned();
-        let k_w = sd.k_w().to_owned();
-        for r in 0..dof {
-            for c in 0..dof {
-                a0[(r, c)] += k_inherent[(r, c)] + k_w[(r, c)];
+        let k = set.dimension();
+        let reset = |a: &mut Mat<f64>| {
+            if a.nrows() == dof && a.ncols() == dof {
+                a.fill(0.0);
+            } else {
+                *a = Mat::zeros(dof, dof);
+            }
+        };
+        reset(&mut pencil.a0);
+        pencil.ai.truncate(k);
+        pencil.ai.iter_mut().for_each(reset);
+        pencil.ai.resize_with(k, || Mat::zeros(dof, dof));
+        // Σ f_p,c H_c, then K_i + K_W entry by entry (the order of the sums of before).
+        sd.cables.add_weighted_hessians(routing, set.particular(), pencil.a0.as_mut())?;
+        reset(&mut pencil.k_w);
+        pencil.k_w.copy_from(sd.k_w());
+        let k_inherent = sd.k_inherent();
+        for c in 0..dof {
+            for r in 0..dof {
+                pencil.a0[(r, c)] += k_inherent[(r, c)] + pencil.k_w[(r, c)];
             }
         }
         let null = set.null_basis();
-        let mut ai = Vec::with_capacity(set.dimension());
-        let mut weights = vec![0.0; set.cable_count()];
-        for i in 0..set.dimension() {
-            for (c, w) in weights.iter_mut().enumerate() {
+        pencil.weights.resize(set.cable_count(), 0.0);
+        for (i, a) in pencil.ai.iter_mut().enumerate() {
+            for (c, w) in pencil.weights.iter_mut().enumerate() {
                 *w = null[(c, i)];
             }
-            let mut a = Mat::<f64>::zeros(dof, dof);
-            sd.cables.add_weighted_hessians(routing, &weights, a.as_mut())?;
-            ai.push(a);
+            sd.cables.add_weighted_hessians(routing, &pencil.weights, a.as_mut())?;
         }
-        Ok(Pencil { a0, ai, j_x: sd.j_x().to_owned() })
+        let j_x = sd.j_x();
+        if pencil.j_x.nrows() == 6 && pencil.j_x.ncols() == dof {
+            pencil.j_x.copy_from(j_x);
+        } else {
+            pencil.j_x = j_x.to_owned();
+        }
+        Ok(())
     }
 }
