@@ -28,7 +28,8 @@ fn frame(model: PatternModel) -> Frame {
     arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
     let set = arm.equilibrium_set(&mut sd).unwrap().clone();
     arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
-    let pencil = planner.pencil(&mut sd, &set).unwrap();
+    let mut pencil = crate::pencil::Pencil::empty();
+    pencil.fill(planner.arm(), &mut sd, &set).unwrap();
     Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[])
 }
 

@@ -16,7 +16,8 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Side};
 use nalgebra::{Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
 
-use sinew_stiffness::compliance_inverse;
+use sinew_statics::EquilibriumSet;
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, compliance_inverse};
 
 use crate::error::PlanError;
 
@@ -42,7 +43,57 @@ pub(crate) struct End {
 }
 
 impl Pencil {
-    /// A pencil with no buffers yet ([`crate::Planner`] fills it).
+    /// `A_0` and the `A_i` of `arm` at the pose of `sd` (after a tension stage there: `K_i` and
+    /// `K_W`), into this pencil's buffers (a plan's pencil is kept in its workspace:
+    /// re-planning along a trajectory allocates none of it again).
+    pub(crate) fn fill(
+        &mut self,
+        arm: &ArmStiffness,
+        sd: &mut ArmStiffnessData,
+        set: &EquilibriumSet,
+    ) -> Result<(), PlanError> {
+        let routing = arm.routing();
+        let dof = arm.dof();
+        let k = set.dimension();
+        let reset = |a: &mut Mat<f64>| {
+            if a.nrows() == dof && a.ncols() == dof {
+                a.fill(0.0);
+            } else {
+                *a = Mat::zeros(dof, dof);
+            }
+        };
+        reset(&mut self.a0);
+        self.ai.truncate(k);
+        self.ai.iter_mut().for_each(reset);
+        self.ai.resize_with(k, || Mat::zeros(dof, dof));
+        // Σ f_p,c H_c, then K_i + K_W entry by entry.
+        sd.cables.add_weighted_hessians(routing, set.particular(), self.a0.as_mut())?;
+        reset(&mut self.k_w);
+        self.k_w.copy_from(sd.k_w());
+        let k_inherent = sd.k_inherent();
+        for c in 0..dof {
+            for r in 0..dof {
+                self.a0[(r, c)] += k_inherent[(r, c)] + self.k_w[(r, c)];
+            }
+        }
+        let null = set.null_basis();
+        self.weights.resize(set.cable_count(), 0.0);
+        for (i, a) in self.ai.iter_mut().enumerate() {
+            for (c, w) in self.weights.iter_mut().enumerate() {
+                *w = null[(c, i)];
+            }
+            sd.cables.add_weighted_hessians(routing, &self.weights, a.as_mut())?;
+        }
+        let j_x = sd.j_x();
+        if self.j_x.nrows() == 6 && self.j_x.ncols() == dof {
+            self.j_x.copy_from(j_x);
+        } else {
+            self.j_x = j_x.to_owned();
+        }
+        Ok(())
+    }
+
+    /// A pencil with no buffers yet ([`Pencil::fill`] sizes them).
     pub(crate) fn empty() -> Pencil {
         Pencil {
             a0: Mat::zeros(0, 0),

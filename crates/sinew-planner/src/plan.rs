@@ -4,7 +4,6 @@
 //! `A(λ)` built from the pose's workspace, the phases ([`crate::phases`]), and the answer
 //! re-evaluated by one more tension stage and the end stage.
 
-use faer::Mat;
 use nalgebra::{Matrix6, Vector6};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
@@ -148,7 +147,7 @@ impl Planner {
             }
         };
         let mut pencil = data.pencil.take().unwrap_or_else(Pencil::empty);
-        self.fill_pencil(sd, &set, &mut pencil)?;
+        pencil.fill(arm, sd, &set)?;
         let mut linear =
             linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
         let previous = data.previous.take();
@@ -414,66 +413,5 @@ impl Planner {
     fn joint_budget_rows(&self, requirements: &Requirements) -> Vec<(std::ops::Range<usize>, f64)> {
         let routing = self.arm.routing();
         requirements.joint_budgets.iter().map(|&(j, b)| (routing.cables_of_joint(j), b)).collect()
-    }
-
-    /// `A_0` and the `A_i` at the pose of `sd` (after a tension stage there: `K_i` and `K_W`).
-    #[cfg(test)]
-    pub(crate) fn pencil(
-        &self,
-        sd: &mut ArmStiffnessData,
-        set: &EquilibriumSet,
-    ) -> Result<Pencil, PlanError> {
-        let mut pencil = Pencil::empty();
-        self.fill_pencil(sd, set, &mut pencil)?;
-        Ok(pencil)
-    }
-
-    /// [`Self::pencil`] into `pencil`, reusing its buffers (a plan's pencil is kept in its
-    /// workspace: re-planning along a trajectory allocates none of it again).
-    pub(crate) fn fill_pencil(
-        &self,
-        sd: &mut ArmStiffnessData,
-        set: &EquilibriumSet,
-        pencil: &mut Pencil,
-    ) -> Result<(), PlanError> {
-        let routing = self.arm.routing();
-        let dof = self.arm.dof();
-        let k = set.dimension();
-        let reset = |a: &mut Mat<f64>| {
-            if a.nrows() == dof && a.ncols() == dof {
-                a.fill(0.0);
-            } else {
-                *a = Mat::zeros(dof, dof);
-            }
-        };
-        reset(&mut pencil.a0);
-        pencil.ai.truncate(k);
-        pencil.ai.iter_mut().for_each(reset);
-        pencil.ai.resize_with(k, || Mat::zeros(dof, dof));
-        // Σ f_p,c H_c, then K_i + K_W entry by entry (the order of the sums of before).
-        sd.cables.add_weighted_hessians(routing, set.particular(), pencil.a0.as_mut())?;
-        reset(&mut pencil.k_w);
-        pencil.k_w.copy_from(sd.k_w());
-        let k_inherent = sd.k_inherent();
-        for c in 0..dof {
-            for r in 0..dof {
-                pencil.a0[(r, c)] += k_inherent[(r, c)] + pencil.k_w[(r, c)];
-            }
-        }
-        let null = set.null_basis();
-        pencil.weights.resize(set.cable_count(), 0.0);
-        for (i, a) in pencil.ai.iter_mut().enumerate() {
-            for (c, w) in pencil.weights.iter_mut().enumerate() {
-                *w = null[(c, i)];
-            }
-            sd.cables.add_weighted_hessians(routing, &pencil.weights, a.as_mut())?;
-        }
-        let j_x = sd.j_x();
-        if pencil.j_x.nrows() == 6 && pencil.j_x.ncols() == dof {
-            pencil.j_x.copy_from(j_x);
-        } else {
-            pencil.j_x = j_x.to_owned();
-        }
-        Ok(())
     }
 }
