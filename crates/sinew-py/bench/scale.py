@@ -1,7 +1,8 @@
 """Python at scale (docs/performance.md): on cdhrm5 (decoupled, E4's load, levels 0.5),
 ``evaluate_many`` with ``threads=1`` and ``threads=2``, ``sinew.dask.map_evaluate`` on a
-LocalCluster of 2 single-threaded worker processes (every field, then the four of a stiffness
-map), all on the same 10**6 rows in the same run; the cost of fetching one chunk's result; Dask's own per-task overhead; the pickled model's size and the time to ship it to the
+LocalCluster of 2 single-threaded worker processes (every field, the rows in shared memory;
+then every field through Dask; then the four of a stiffness map through Dask), all on the same
+10**6 rows in the same run; the cost of fetching one chunk's result; Dask's own per-task overhead; the pickled model's size and the time to ship it to the
 workers.
 
 Build the release module first, in its own virtualenv (as bench.py):
@@ -48,7 +49,8 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--rows", type=int, default=1_000_000)
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--chunk", type=int, default=sinew.dask.DEFAULT_CHUNK)
+    parser.add_argument("--chunk", type=int, default=None,
+                        help="rows per task (default: map_evaluate's own)")
     args = parser.parse_args()
     robot = sinew.load_robot(ROOT / "robots" / "cdhrm5")
     arms = {m: sinew.ArmStiffness(robot, sinew.load_routing(robot, m))
@@ -76,41 +78,56 @@ def main():
     cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                        dashboard_address=None)
     client = distributed.Client(cluster)
+    # The rows per task: as given, or map_evaluate's default for 2 workers.
+    chunk = args.chunk or max(sinew.dask.DEFAULT_CHUNK,
+                              -(-n // (sinew.dask.TASKS_PER_WORKER * 2)))
     try:
         # Warm the workers (import sinew, first pool) before timing.
-        sinew.dask.map_evaluate(arm, Q[:2 * args.chunk], wrench=E4_F0, levels=levels,
+        sinew.dask.map_evaluate(arm, Q[:2 * chunk], wrench=E4_F0, levels=levels,
                                 chunk=args.chunk, client=client)
         dt, m = best(lambda: sinew.dask.map_evaluate(
             arm, Q, wrench=E4_F0, levels=levels, chunk=args.chunk, client=client), args.repeat)
         assert m.errors == errors1 and m.k_fd.tobytes() == k_fd1
         m = None
-        tasks = -(-n // args.chunk)
-        print(f"map_evaluate, 2 workers x 1 thread, chunk {args.chunk}: {dt:.3f} s "
+        tasks = -(-n // chunk)
+        print(f"map_evaluate (shared rows in {sinew._shared.DIRECTORY}), 2 workers x 1 thread, "
+              f"chunk {chunk}: {dt:.3f} s "
               f"({n / dt / 1e3:.0f} k rows/s), {one / dt:.2f}x evaluate_many(threads=1); "
               f"{tasks} tasks; time beyond the ideal (threads=1 time / 2) per task: "
               f"{(dt - one / 2) / tasks * 1e3:.1f} ms")
-        # The same map keeping only the fields a stiffness map needs: what the workers send
-        # back is most of a map's cost on one machine (the client deserialises every byte).
+        # Every row through Dask instead of the shared file (what a cluster of other hosts
+        # does): what the workers send back is most of a map's cost on one machine (the
+        # client deserialises every byte).
+        dt_d, md = best(lambda: sinew.dask.map_evaluate(
+            arm, Q, wrench=E4_F0, levels=levels, chunk=args.chunk, client=client,
+            shared_memory=False), args.repeat)
+        assert md.errors == errors1 and md.k_fd.tobytes() == k_fd1
+        md = None
+        print(f"map_evaluate, shared_memory=False (every row through Dask): {dt_d:.3f} s "
+              f"({n / dt_d / 1e3:.0f} k rows/s), {one / dt_d:.2f}x evaluate_many(threads=1); "
+              f"{(dt_d - one / 2) / tasks * 1e3:.1f} ms per task beyond the ideal")
+        # The same keeping only the fields a stiffness map needs.
         fields = ["ok", "stable", "min_eigenvalue", "k_fd"]
         dt_f, mf = best(lambda: sinew.dask.map_evaluate(
             arm, Q, wrench=E4_F0, levels=levels, chunk=args.chunk, client=client,
-            fields=fields), args.repeat)
+            fields=fields, shared_memory=False), args.repeat)
         assert mf.errors == errors1 and mf.k_fd.tobytes() == k_fd1
         kept_bytes = sum(getattr(mf, f).nbytes for f in fields) / n
-        print(f"map_evaluate, fields={fields}: {dt_f:.3f} s ({n / dt_f / 1e3:.0f} k rows/s), "
-              f"{one / dt_f:.2f}x evaluate_many(threads=1); {kept_bytes:.0f} bytes per row "
-              f"sent back instead of {row_bytes:.0f}")
+        mf = None
+        print(f"map_evaluate, shared_memory=False, fields={fields}: {dt_f:.3f} s "
+              f"({n / dt_f / 1e3:.0f} k rows/s), {one / dt_f:.2f}x evaluate_many(threads=1); "
+              f"{kept_bytes:.0f} bytes per row sent back instead of {row_bytes:.0f}")
         # One chunk's whole result, computed on a worker, then fetched: the gather's cost.
         model = client.scatter(arm, broadcast=True, hash=False)
         names = list(sinew.dask._EVALUATE)
-        fut = client.submit(sinew.dask._evaluate_chunk, model, Q[:args.chunk], E4_F0, 0,
+        fut = client.submit(sinew.dask._evaluate_chunk, model, Q[:chunk], E4_F0, 0,
                             names, levels=levels, pure=False)
         distributed.wait(fut)
         t = time.perf_counter()
         fut.result()
         fetch = time.perf_counter() - t
-        print(f"fetching one chunk's whole result ({args.chunk * row_bytes / 1e6:.1f} MB): "
-              f"{fetch * 1e3:.1f} ms, {args.chunk * row_bytes / fetch / 1e6:.0f} MB/s; "
+        print(f"fetching one chunk's whole result ({chunk * row_bytes / 1e6:.1f} MB): "
+              f"{fetch * 1e3:.1f} ms, {chunk * row_bytes / fetch / 1e6:.0f} MB/s; "
               f"{tasks} chunks: {fetch * tasks:.2f} s of the client's time")
         k = 500
         per_task, _ = best(lambda: client.gather(client.map(noop, range(k), pure=False)),

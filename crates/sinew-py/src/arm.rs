@@ -8,15 +8,16 @@ use std::sync::{Mutex, OnceLock};
 use std::collections::BTreeMap;
 
 use nalgebra::Vector6;
-use numpy::IntoPyArray;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use sinew::planner::{Planner, PlannerData};
 use sinew::statics::{Chosen, TensionChoice, TensionPolicy};
 use sinew::stiffness::ArmStiffnessData;
 
-use crate::batch::{Batch, BatchChoice, evaluate_many};
-use crate::convert::{matrix, na2, reshape, vec1, vector, wrenches};
-use crate::errors::{exception, input, library};
+use crate::batch::BatchChoice;
+use crate::batch_out::evaluate_to_numpy;
+use crate::convert::{matrix, na2, vec1, vector, wrenches};
+use crate::errors::{input, library};
 use crate::lazy::LazyArray;
 use crate::model::{Robot, Routing};
 use crate::plan_along::along_result;
@@ -224,8 +225,9 @@ impl ArmStiffness {
     /// same for every row) or `policy`; default as `evaluate`. A row that fails (outside the
     /// limits, NaN, infeasible) is NaN, `ok` False, its error in `errors`; an unstable row is
     /// `ok`, `stable` False. When every row of a non-empty batch fails, the first row's error
-    /// is raised (unless `raise_if_all_fail` is False).
-    #[pyo3(signature = (Q, wrench = None, levels = None, policy = None, threads = None, raise_if_all_fail = true))]
+    /// is raised (unless `raise_if_all_fail` is False). `out` (a dict of field names to
+    /// writable C-contiguous arrays of the result's shapes) receives those fields in place.
+    #[pyo3(signature = (Q, wrench = None, levels = None, policy = None, threads = None, raise_if_all_fail = true, out = None))]
     #[allow(non_snake_case)]
     fn evaluate_many<'py>(
         &self,
@@ -236,6 +238,7 @@ impl ArmStiffness {
         policy: Option<&str>,
         threads: Option<i64>,
         raise_if_all_fail: bool,
+        out: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<BatchResult> {
         let arm = &self.arm;
         let dof = arm.dof();
@@ -249,31 +252,7 @@ impl ArmStiffness {
             (None, Some(p)) => BatchChoice::Policy(self::policy(p)?),
             (None, None) => BatchChoice::Default,
         };
-        let batch = py.detach(|| run(threads, || evaluate_many(arm, &q, &f0, &choice)))?;
-        if let Some((_, kind, message)) = batch.errors.first()
-            && batch.errors.len() == rows
-            && raise_if_all_fail
-        {
-            return Err(exception(*kind, format!("every row failed; row 0: {message}")));
-        }
-        // The buffers move into numpy (no copy of the 10⁶-row results).
-        let Batch {
-            cables, ok, stable, min_eigenvalue, t0, tensions, c_x, k_x, k_fd, errors, ..
-        } = batch;
-        Ok(BatchResult {
-            ok: ok.into_pyarray(py).into_any().unbind(),
-            stable: stable.into_pyarray(py).into_any().unbind(),
-            min_eigenvalue: min_eigenvalue.into_pyarray(py).into_any().unbind(),
-            t0: reshape(t0.into_pyarray(py), &[rows, dof])?.unbind(),
-            tensions: reshape(tensions.into_pyarray(py), &[rows, cables])?.unbind(),
-            c_x: reshape(c_x.into_pyarray(py), &[rows, 6, 6])?.unbind(),
-            k_x: reshape(k_x.into_pyarray(py), &[rows, 6, 6])?.unbind(),
-            k_fd: reshape(k_fd.into_pyarray(py), &[rows, 3, 3])?.unbind(),
-            errors: errors
-                .into_iter()
-                .map(|(r, kind, message)| (r, kind.to_string(), message))
-                .collect(),
-        })
+        evaluate_to_numpy(py, arm, &q, &f0, &choice, threads, out, raise_if_all_fail)
     }
 
     /// The tensions that optimise the end stiffness at `q` under `wrench` (`sinew plan`):

@@ -66,6 +66,30 @@ struct Part<'a> {
     k_fd: &'a mut [f64],
 }
 
+/// Every result buffer of a batch, borrowed (row-major, `rows ×` the width of [`Batch`]'s
+/// field of the same name): a batch's own, or the caller's (`evaluate_many(out=…)`, which
+/// writes into a map's shared rows). Every entry is written once by its row, a value or NaN,
+/// whatever the buffer held before.
+#[derive(Debug)]
+pub struct Outputs<'a> {
+    /// As [`Batch::ok`].
+    pub ok: &'a mut [bool],
+    /// As [`Batch::stable`].
+    pub stable: &'a mut [bool],
+    /// As [`Batch::min_eigenvalue`].
+    pub min_eigenvalue: &'a mut [f64],
+    /// As [`Batch::t0`].
+    pub t0: &'a mut [f64],
+    /// As [`Batch::tensions`].
+    pub tensions: &'a mut [f64],
+    /// As [`Batch::c_x`].
+    pub c_x: &'a mut [f64],
+    /// As [`Batch::k_x`].
+    pub k_x: &'a mut [f64],
+    /// As [`Batch::k_fd`].
+    pub k_fd: &'a mut [f64],
+}
+
 /// Evaluate every row of `q` (rows × dof, row-major) under the load `f0`: one wrench for
 /// every row (`f0.len() == 1`) or one per row (`f0.len() == rows`). In parallel on the rayon
 /// pool it is called in (the global pool outside any), each task writing its rows straight
@@ -95,14 +119,55 @@ pub fn evaluate_many(
         k_fd: vec![0.0; rows * 9],
         errors: Vec::new(),
     };
-    let parts: Vec<Part<'_>> = cut(&mut batch.ok, 1, rows)
-        .zip(cut(&mut batch.stable, 1, rows))
-        .zip(cut(&mut batch.min_eigenvalue, 1, rows))
-        .zip(cut(&mut batch.t0, dof, rows))
-        .zip(cut(&mut batch.tensions, cables, rows))
-        .zip(cut(&mut batch.c_x, 36, rows))
-        .zip(cut(&mut batch.k_x, 36, rows))
-        .zip(cut(&mut batch.k_fd, 9, rows))
+    let out = Outputs {
+        ok: &mut batch.ok,
+        stable: &mut batch.stable,
+        min_eigenvalue: &mut batch.min_eigenvalue,
+        t0: &mut batch.t0,
+        tensions: &mut batch.tensions,
+        c_x: &mut batch.c_x,
+        k_x: &mut batch.k_x,
+        k_fd: &mut batch.k_fd,
+    };
+    batch.errors = evaluate_into(arm, q, f0, choice, out);
+    batch
+}
+
+/// [`evaluate_many`] into the caller's buffers; the `(row, kind, message)` of every failed
+/// row, in row order.
+///
+/// # Panics
+///
+/// When a buffer's length is not `rows ×` its width (the caller sizes them).
+pub fn evaluate_into(
+    arm: &ArmStiffness,
+    q: &[f64],
+    f0: &[Vector6<f64>],
+    choice: &BatchChoice,
+    out: Outputs<'_>,
+) -> Vec<(usize, ErrorKind, String)> {
+    let dof = arm.dof();
+    let cables = arm.routing().cable_count();
+    let rows = q.len().checked_div(dof).unwrap_or(0);
+    let widths = [
+        (out.ok.len(), 1),
+        (out.stable.len(), 1),
+        (out.min_eigenvalue.len(), 1),
+        (out.t0.len(), dof),
+        (out.tensions.len(), cables),
+        (out.c_x.len(), 36),
+        (out.k_x.len(), 36),
+        (out.k_fd.len(), 9),
+    ];
+    assert!(widths.iter().all(|&(n, w)| n == rows * w), "evaluate_into: buffers of the wrong size");
+    let parts: Vec<Part<'_>> = cut(out.ok, 1, rows)
+        .zip(cut(out.stable, 1, rows))
+        .zip(cut(out.min_eigenvalue, 1, rows))
+        .zip(cut(out.t0, dof, rows))
+        .zip(cut(out.tensions, cables, rows))
+        .zip(cut(out.c_x, 36, rows))
+        .zip(cut(out.k_x, 36, rows))
+        .zip(cut(out.k_fd, 9, rows))
         .map(|(((((((ok, stable), min_eigenvalue), t0), tensions), c_x), k_x), k_fd)| Part {
             ok,
             stable,
@@ -134,8 +199,7 @@ pub fn evaluate_many(
             },
         )
         .collect();
-    batch.errors = errors.into_iter().flatten().collect();
-    batch
+    errors.into_iter().flatten().collect()
 }
 
 /// `buffer` (`rows × width`, row-major) cut into the tasks' blocks of [`CHUNK`] rows, one block

@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 
 mod arm;
 pub mod batch;
+mod batch_out;
 mod convert;
 mod errors;
 mod export;

@@ -116,3 +116,46 @@ def test_policy_batch():
     b = arm.evaluate_many(Q, [0, 2, 0, 0, 0, 0], policy="safest")
     for r in range(2):
         close(b.tensions[r], arm.evaluate(Q[r], [0, 2, 0, 0, 0, 0], policy="safest").tensions, 0)
+
+
+def test_out_writes_the_fields_in_place(robot, arm):
+    # out= (what sinew.dask's shared rows use): the given arrays are the result's, written
+    # bit for bit as the batch's own, failed rows included, whatever they held before.
+    from test_pickle import BATCH, rows, same
+
+    Q = rows(robot, 300, seed=21)
+    b = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5)
+    assert len(b.errors) == 3
+    for names in (BATCH, ["k_fd", "ok"], ["stable", "t0", "c_x"]):
+        out = {n: np.full_like(getattr(b, n), True if n in ("ok", "stable") else 7.0)
+               for n in names}
+        o = arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5, out=out)
+        for n in BATCH:
+            same(getattr(o, n), getattr(b, n))
+            assert (getattr(o, n) is out.get(n)) == (n in names)
+        assert o.errors == b.errors
+    # Rows of a bigger C-contiguous array: a view is written, the rest untouched.
+    big = np.zeros((400, 3, 3))
+    arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5, out={"k_fd": big[50:350]})
+    same(big[50:350], b.k_fd)
+    assert not big[:50].any() and not big[350:].any()
+    k = np.zeros((300, 3, 3))
+    for out, match in [
+        ({"k_q": k}, 'out: no field "k_q"'),
+        ({3: k}, "out: its keys are field names"),
+        ({"k_fd": np.zeros((300, 9))}, r"out\[\"k_fd\"\]: .*shape \[300, 3, 3\]"),
+        ({"k_fd": np.zeros((300, 3, 3), dtype=np.float32)}, r"out\[\"k_fd\"\]: .*float64"),
+        ({"k_fd": np.zeros((300, 3, 3), order="F")}, "C-contiguous"),
+        ({"k_fd": np.zeros((600, 3, 3))[::2]}, "C-contiguous"),
+        ({"ok": np.zeros(300)}, r"out\[\"ok\"\]: .*bool"),
+        ({"k_fd": np.zeros((300, 3, 3)).copy(), "t0": None}, r"out\[\"t0\"\]"),
+        ({"c_x": np.zeros((300, 6, 6)), "k_x": "the same"}, r"out\[\"k_x\"\]"),
+    ]:
+        with pytest.raises(sinew.InputError, match=match):
+            arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5, out=out)
+    frozen = np.zeros((300, 3, 3))
+    frozen.flags.writeable = False
+    shared = np.zeros((300, 6, 6))
+    for out in ({"k_fd": frozen}, {"c_x": shared, "k_x": shared}):
+        with pytest.raises(sinew.InputError, match="writable C-contiguous .* shares no memory"):
+            arm.evaluate_many(Q, E4_F0, levels=[0.5] * 5, out=out)

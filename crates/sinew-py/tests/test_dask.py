@@ -2,6 +2,8 @@
 in-process batch calls bit for bit (failed rows included), the model is scattered once per
 worker, lazy results are dask arrays, and a worker killed mid-run loses nothing."""
 
+import glob
+import mmap
 import os
 import signal
 import threading
@@ -162,6 +164,61 @@ def test_client_none_starts_a_local_cluster(robot, arm):
     Q = workspace(robot, 1_000)
     m = sinew.dask.map_evaluate(arm, Q, wrench=E4_F0, levels=LEVELS, chunk=400)
     equal(m, arm.evaluate_many(Q, E4_F0, levels=LEVELS), BATCH)
+
+
+def shared(a):
+    """Whether ``a`` is a view of a memory map (the shared file of a map)."""
+    while isinstance(a, np.ndarray):
+        a = a.base
+    return isinstance(a, mmap.mmap)
+
+
+def leftovers():
+    return sorted(glob.glob(os.path.join(sinew._shared.DIRECTORY, "sinew-map-*")))
+
+
+def test_shared_memory_and_dask_carry_the_same_bits(client, robot, arm, monkeypatch):
+    Q = workspace(robot, 6_000, seed=13)
+    before = leftovers()
+    b = arm.evaluate_many(Q, E4_F0, levels=LEVELS)
+    W = np.zeros((6_000, 6))
+    W[:, 1] = np.linspace(0, 6, 6_000)
+    for wanted in (None, True, False):
+        m = sinew.dask.map_evaluate(arm, Q, wrench=E4_F0, levels=LEVELS, chunk=1_000,
+                                    client=client, shared_memory=wanted)
+        equal(m, b, BATCH)
+        # Through /dev/shm unless told not to: the fields are views of the map's file.
+        assert all(shared(getattr(m, f)) == (wanted is not False) for f in BATCH)
+        # Per-row wrenches, a Fortran-order float32 Q, a dask Q: read where they are.
+        for q in (Q, np.asfortranarray(Q.astype(np.float32)), da.from_array(Q, chunks=777)):
+            expected = arm.evaluate_many(q if isinstance(q, np.ndarray) else Q, W,
+                                         levels=LEVELS)
+            m = sinew.dask.map_evaluate(arm, q, wrench=W, levels=LEVELS, chunk=1_500,
+                                        client=client, shared_memory=wanted)
+            equal(m, expected, BATCH)
+    p = sinew.dask.map_plan(arm, Q[:300], wrench=E4_F0, objective="volume", chunk=100,
+                            client=client)
+    equal(p, arm.plan_many(Q[:300], E4_F0, "volume"), PLAN)
+    assert shared(p.value)
+    # Nothing is left behind, after a map or after one whose every row failed.
+    with pytest.raises(sinew.InputError, match="every row failed"):
+        sinew.dask.map_evaluate(arm, Q[:50] + 9.0, levels=LEVELS, client=client)
+    assert leftovers() == before
+    # No room (or no /dev/shm): through Dask, or an error when it was required.
+    monkeypatch.setattr(sinew._shared, "DIRECTORY", "/nonexistent-sinew-shm")
+    m = sinew.dask.map_evaluate(arm, Q[:2_000], wrench=E4_F0, levels=LEVELS, chunk=500,
+                                client=client)
+    assert not shared(m.k_fd)
+    equal(m, arm.evaluate_many(Q[:2_000], E4_F0, levels=LEVELS), BATCH)
+    with pytest.raises(sinew.InputError, match="shared_memory=True: /nonexistent-sinew-shm"):
+        sinew.dask.map_evaluate(arm, Q, levels=LEVELS, client=client, shared_memory=True)
+    monkeypatch.undo()
+    for kw, match in [(dict(shared_memory="yes"), "shared_memory: expected None, True"),
+                      (dict(shared_memory=True, compute=False), "lazy map")]:
+        with pytest.raises(sinew.InputError, match=match):
+            sinew.dask.map_evaluate(arm, Q, levels=LEVELS, client=client, **kw)
+    # A worker that cannot read the client's file, or reads another token, says so.
+    assert not sinew._shared.sees("/nonexistent-sinew-shm/x", b"0" * 16)
 
 
 def test_a_worker_killed_mid_run(client, big, arm):

@@ -256,9 +256,12 @@ class ArmStiffness:
         policy: Optional[Policy] = None,
         threads: Optional[int] = None,
         raise_if_all_fail: bool = True,
+        out: Optional[dict[str, np.ndarray]] = None,
     ) -> BatchResult:
         """Every row of ``Q`` (N, dof) in parallel under ``wrench`` ((6,) for every row, or
-        (N, 6)); raises only when every row fails (and ``raise_if_all_fail``)."""
+        (N, 6)); raises only when every row fails (and ``raise_if_all_fail``). ``out`` maps
+        field names to writable C-contiguous arrays of the result's shapes (bool for ``ok``
+        and ``stable``, float64 else), written in place and returned as those fields."""
     def plan(
         self,
         q: ArrayLike,

@@ -2,8 +2,9 @@
 "./crates/sinew-py[dask]"``, which brings ``dask[array]`` and ``distributed``).
 
 Sinew does not schedule anything itself: ``map_evaluate`` and ``map_plan`` cut the rows of
-``Q`` into chunks (``chunk`` rows each, default 10 000: Dask's overhead is about 2 ms per
-task, a chunk of cdhrm5 about 40 ms), ship the model once per worker (``client.scatter(arm,
+``Q`` into chunks (``chunk`` rows each; by default about ``TASKS_PER_WORKER`` = 8 tasks per
+worker and at least ``DEFAULT_CHUNK`` = 10 000 rows a task: Dask's overhead is about 2 ms per
+task, 10 000 rows of cdhrm5 about 100 ms of work), ship the model once per worker (``client.scatter(arm,
 broadcast=True)``: it pickles by value, the URDF, ``robot.toml`` and routing texts, never a
 path), and run each chunk as one task (a numpy ``Q`` travels in the task graph, a dask ``Q``
 is computed where its chunks' tasks run) calling ``evaluate_many`` / ``plan_many`` with
@@ -26,6 +27,13 @@ the result (``ok`` False, NaN, its error in ``errors``); when every row fails, t
 error is raised, as ``evaluate_many`` does. ``fields=["ok", "stable", "k_fd"]`` keeps only
 those fields (``ok`` always, and ``errors``): the workers send back only them, which is most of
 a map's cost when the results are large (a full cdhrm5 row is 1.2 kB, its ``k_fd`` 72 bytes).
+
+When every worker sees the client's ``/dev/shm`` (a ``LocalCluster``, or workers on the
+client's host; checked by a token each worker reads), a computed map moves no rows through
+Dask at all: ``Q`` and the result's fields live in one file there, each task reads and writes
+its own rows, and only the failed rows' errors travel (``sinew._shared``). The result's arrays
+are then views of that memory (the file itself is unlinked when the map returns).
+``shared_memory=False`` sends everything through Dask; ``True`` requires the shared file.
 """
 
 from __future__ import annotations
@@ -45,6 +53,7 @@ except ImportError as e:  # pragma: no cover - the message is the point
         "sinew.dask needs dask[array] and distributed: pip install './crates/sinew-py[dask]'"
     ) from e
 
+from . import _shared
 from ._sinew import (
     ArmStiffness,
     InfeasibleError,
@@ -54,10 +63,17 @@ from ._sinew import (
     UnstableError,
 )
 
-__all__ = ["DEFAULT_CHUNK", "MapResult", "map_evaluate", "map_plan"]
+__all__ = ["DEFAULT_CHUNK", "TASKS_PER_WORKER", "MapResult", "map_evaluate", "map_plan"]
 
 DEFAULT_CHUNK = 10_000
-"""Rows per task unless ``chunk`` says otherwise."""
+"""The fewest rows per task when ``chunk`` is None (Dask's overhead is about 2 ms a task, 10 000
+rows of cdhrm5 about 100 ms of work)."""
+
+TASKS_PER_WORKER = 8
+"""With ``chunk`` None, the rows are cut into about this many tasks per worker (and no
+fewer than ``DEFAULT_CHUNK`` rows a task): few enough that Dask's per-task cost and the
+client's share of the cores stay small, enough to balance the workers, show progress and
+lose little when a worker is lost."""
 
 
 class MapResult:
@@ -90,19 +106,19 @@ class MapResult:
         return MapResult(dict(zip(self._names, client.gather(futures))))
 
 
-def _evaluate_chunk(arm, Q, wrench, offset, names, levels=None, policy=None):
-    """One task: ``evaluate_many`` on one chunk with ``threads=1``, the fields ``names`` kept,
-    errors renumbered."""
+def _evaluate_chunk(arm, Q, wrench, offset, names, levels=None, policy=None, out=None):
+    """One task: ``evaluate_many`` on one chunk with ``threads=1``, the fields ``names`` kept
+    (or written into ``out``'s arrays: then only ``written``), errors renumbered."""
     b = arm.evaluate_many(Q, wrench, levels=levels, policy=policy, threads=1,
-                          raise_if_all_fail=False)
-    out = {name: getattr(b, name) for name in names}
-    out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
-    return out
+                          raise_if_all_fail=False, out=out)
+    kept = {"written": True} if out is not None else {name: getattr(b, name) for name in names}
+    kept["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
+    return kept
 
 
-def _plan_chunk(arm, Q, wrench, offset, names, options=None):
+def _plan_chunk(arm, Q, wrench, offset, names, options=None, out=None):
     """One task: ``plan_many`` on one chunk with ``threads=1``, the fields ``names`` kept,
-    errors renumbered."""
+    errors renumbered (``plan_many`` has no ``out``: the caller copies the fields into it)."""
     b = arm.plan_many(Q, wrench, threads=1, raise_if_all_fail=False, **(options or {}))
     out = {name: getattr(b, name) for name in names}
     out["errors"] = [(offset + r, kind, message) for r, kind, message in b.errors]
@@ -238,30 +254,86 @@ class _Session:
                 self.cluster.close()
 
 
-def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
+def _shared_rows(client, arm, Q, wrench, per_row, fields, rows, wanted):
+    """The shared file of a map (``_shared.SharedRows``, inputs copied in) when its workers
+    see the client's ``/dev/shm`` and ``wanted`` is not False; else None (``wanted`` True:
+    ``InputError``)."""
+    if wanted is not None and not isinstance(wanted, bool):
+        raise InputError(f"shared_memory: expected None, True or False, got {wanted!r}")
+    if wanted is False:
+        return None
+    arrays = {name: ((rows, *shape(arm)), dtype) for name, (shape, dtype) in fields.items()}
+    inputs = {"in:Q": Q}
+    if per_row:
+        inputs["in:wrench"] = wrench
+    for name, x in inputs.items():
+        # A dask array is computed where its chunks' tasks run; an array numpy cannot hold
+        # in a numeric buffer travels as it is.
+        if isinstance(x, np.ndarray) and x.dtype.kind in "fiu":
+            arrays[name] = (x.shape, x.dtype)
+    _, size = _shared.plan_layout(arrays)
+    why = None
+    if not _shared.room_for(size):
+        why = f"{_shared.DIRECTORY} is missing or has not twice the {size:,} bytes free"
+    else:
+        rows_file = _shared.SharedRows(arrays)
+        seen = client.run(_shared.sees, rows_file.layout.path, rows_file.layout.token)
+        if seen and all(seen.values()):
+            for name, x in inputs.items():
+                if name in arrays:
+                    rows_file.views[name][...] = x
+            return rows_file
+        rows_file.close()
+        why = "a worker does not see the client's " + _shared.DIRECTORY if seen else "no worker"
+    if wanted:
+        raise InputError(f"shared_memory=True: {why}")
+    return None
+
+
+def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields, shared_memory=None):
     """Cut ``Q`` into chunks, run ``task(model, Q_chunk, wrench_chunk, offset, names)`` on
-    each, and stack the fields."""
+    each, and stack the fields (in a shared file when the workers see it)."""
     if not isinstance(arm, ArmStiffness):
         raise InputError(f"arm: expected a sinew.ArmStiffness, got {type(arm).__name__}")
-    chunk = DEFAULT_CHUNK if chunk is None else chunk
-    if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
+    if chunk is not None and (not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool)
+                              or chunk < 1):
         raise InputError(f"chunk: expected a number of rows ≥ 1, got {chunk!r}")
     Q = _rows(arm, Q)
     rows = int(Q.shape[0])
     wrench, per_row = _wrench_rows(wrench, rows)
     session = _Session(client)
+    shared = None
     try:
+        if compute:
+            shared = _shared_rows(session.client, arm, Q, wrench, per_row, fields, rows,
+                                  shared_memory)
+        elif shared_memory:
+            raise InputError("shared_memory=True: a lazy map (compute=False) keeps its rows "
+                             "on the cluster")
         # The model, once per worker (it pickles by value); the tasks refer to it by key. A
         # key of its own per map (hash=False): two maps of one model in a row on one client
         # would otherwise share the key, and the first's release could drop the second's data.
         model = session.client.scatter(arm, broadcast=True, hash=False)
         names = list(fields)
+        if chunk is None:
+            workers = max(1, len(session.client.scheduler_info().get("workers", {})))
+            chunk = max(DEFAULT_CHUNK, -(-rows // (TASKS_PER_WORKER * workers)))
         starts = list(range(0, rows, int(chunk)))
         parts = []
         for a in starts:
             b = min(a + int(chunk), rows)
-            w = _block(wrench, a, b) if per_row else wrench
-            parts.append((a, b, dask.delayed(task, pure=True)(model, _block(Q, a, b), w, a, names)))
+            if shared is None:
+                w = _block(wrench, a, b) if per_row else wrench
+                parts.append((a, b, dask.delayed(task, pure=True)(model, _block(Q, a, b), w, a,
+                                                                  names)))
+                continue
+            # Only the row range travels, with the inputs the file could not hold.
+            layout = shared.layout
+            q = None if "in:Q" in layout.arrays else _block(Q, a, b)
+            w = (None if "in:wrench" in layout.arrays else _block(wrench, a, b)) if per_row \
+                else wrench
+            parts.append((a, b, dask.delayed(_shared.run_chunk, pure=True)(
+                task, model, layout, a, b, q, w, per_row, names)))
         if compute:
             futures = session.client.compute([p for _, _, p in parts])
             if progress:
@@ -269,15 +341,17 @@ def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
             # Each chunk's result fetched as soon as its task ends (while the others run) and
             # copied into its rows, then let go on the worker: no gather at the end, no
             # concatenation.
-            out = {name: np.empty((rows, *shape(arm)), dtype=dtype)
-                   for name, (shape, dtype) in fields.items()}
+            out = ({name: shared.views[name] for name in fields} if shared is not None else
+                   {name: np.empty((rows, *shape(arm)), dtype=dtype)
+                    for name, (shape, dtype) in fields.items()})
             errors = [[] for _ in parts]
             chunk_of = {f.key: i for i, f in enumerate(futures)}
             for future, done in distributed.as_completed(futures, with_results=True):
                 i = chunk_of[future.key]
                 a, b, _ = parts[i]
-                for name in fields:
-                    out[name][a:b] = done[name]
+                if not done.get("shared"):
+                    for name in fields:
+                        out[name][a:b] = done[name]
                 errors[i] = done["errors"]
                 future.release()
             out["errors"] = _all_errors(*errors)
@@ -298,6 +372,8 @@ def _run(arm, Q, wrench, chunk, client, compute, progress, task, fields):
         session = None
         return lazy
     finally:
+        if shared is not None:
+            shared.close()
         if session is not None:
             session.close()
 
@@ -313,11 +389,14 @@ def map_evaluate(
     compute: bool = True,
     progress: bool = False,
     fields: Optional[list] = None,
+    shared_memory: Optional[bool] = None,
 ) -> MapResult:
     """``arm.evaluate_many(Q, wrench, levels=…, policy=…)`` on a Dask cluster, chunk by chunk
     (``threads=1`` per chunk): the same fields, bit for bit, failed rows included. ``Q`` is
     (N, dof), a numpy or dask array; ``wrench`` one (6,) for every row or (N, 6); ``fields``
-    the names of ``BatchResult``'s fields to keep (None: all)."""
+    the names of ``BatchResult``'s fields to keep (None: all); ``shared_memory`` whether the
+    rows go through ``/dev/shm`` instead of Dask (None: when every worker sees the client's,
+    True: required, False: never; see the module's text)."""
     chosen = _chosen(_EVALUATE, fields)
     Q = _rows(arm, Q)
     if levels is not None:
@@ -328,7 +407,8 @@ def map_evaluate(
                       levels=levels, policy=policy, threads=1)
 
     return _run(arm, Q, wrench, chunk, client, compute, progress,
-                functools.partial(_evaluate_chunk, levels=levels, policy=policy), chosen)
+                functools.partial(_evaluate_chunk, levels=levels, policy=policy), chosen,
+                shared_memory)
 
 
 def map_plan(
@@ -340,12 +420,14 @@ def map_plan(
     compute: bool = True,
     progress: bool = False,
     fields: Optional[list] = None,
+    shared_memory: Optional[bool] = None,
     **options: Any,
 ) -> MapResult:
     """``arm.plan_many(Q, wrench, **options)`` on a Dask cluster, chunk by chunk (``threads=1``
     per chunk): the same fields, bit for bit, failed rows included. ``options`` are
     ``plan``'s (``objective``, ``direction``, ``k_min``, ``margin``, ``budget``, …); ``fields``
-    the names of ``PlanBatchResult``'s fields to keep (None: all)."""
+    the names of ``PlanBatchResult``'s fields to keep (None: all); ``shared_memory`` as
+    ``map_evaluate``'s."""
     chosen = _chosen(_plan_fields(arm), fields)
     for bad in ("threads", "raise_if_all_fail"):
         if bad in options:
@@ -355,4 +437,4 @@ def map_plan(
     arm.plan_many(np.zeros((0, arm.dof)), None if w is None or per_row else w, threads=1,
                   **options)
     return _run(arm, Q, wrench, chunk, client, compute, progress,
-                functools.partial(_plan_chunk, options=options), chosen)
+                functools.partial(_plan_chunk, options=options), chosen, shared_memory)
