@@ -95,13 +95,13 @@ class SharedRows:
 
 
 def room_for(size: int) -> bool:
-    """Whether ``DIRECTORY`` exists and has twice ``size`` bytes free (a full tmpfs would
-    kill the worker writing into it with SIGBUS, not raise)."""
+    """Whether ``DIRECTORY`` exists and has twice ``size`` bytes free, and 8 MB more (a full
+    tmpfs would kill the worker writing into it with SIGBUS, not raise)."""
     try:
         st = os.statvfs(DIRECTORY)
     except OSError:
         return False
-    return st.f_bavail * st.f_frsize >= 2 * size + (64 << 20)
+    return st.f_bavail * st.f_frsize >= 2 * size + (8 << 20)
 
 
 def sees(path: str, token: bytes) -> bool:
