@@ -44,6 +44,16 @@ pub enum StiffnessError {
         /// The direction passed.
         direction: [f64; 3],
     },
+    /// A zero or non-finite wrench direction (a stick load limit's).
+    #[error(
+        "wrench direction [{}, {}, {}, {}, {}, {}] is not a non-zero finite vector",
+        Compact(.direction[0]), Compact(.direction[1]), Compact(.direction[2]),
+        Compact(.direction[3]), Compact(.direction[4]), Compact(.direction[5])
+    )]
+    InvalidWrenchDirection {
+        /// The direction passed (force, then moment).
+        direction: [f64; 6],
+    },
     /// A stage of the pipeline asked for before the stage it needs: tensions before a pose
     /// ([`crate::ArmStiffness::set_pose`]), the end before tensions
     /// ([`crate::ArmStiffness::set_tensions`]).
@@ -125,6 +135,7 @@ impl StiffnessError {
             | StiffnessError::WorkspaceMismatch { .. } => ErrorKind::Numerical,
             StiffnessError::DimensionMismatch { .. }
             | StiffnessError::InvalidDirection { .. }
+            | StiffnessError::InvalidWrenchDirection { .. }
             | StiffnessError::StageMissing { .. }
             | StiffnessError::StickWithoutFriction { .. }
             | StiffnessError::WrongCapstanWeights { .. } => ErrorKind::Input,

@@ -44,6 +44,7 @@ mod joint;
 mod outcome;
 mod slip;
 mod stick;
+mod stick_limit;
 mod structured;
 
 pub use arm::ArmStiffness;
@@ -57,3 +58,7 @@ pub use joint::{joint_block, joint_stiffness, stiffness_slope};
 pub use outcome::{Outcome, OutcomeNote};
 pub use slip::slip_stiffness;
 pub use stick::stick_stiffness;
+pub use stick_limit::{
+    BandEdge, EDGE_TOLERANCE, HoleEvent, RATE_TOLERANCE, StickLoadLimit, base_directions,
+    stick_load_limits,
+};

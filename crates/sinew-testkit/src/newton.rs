@@ -89,6 +89,15 @@ impl<'a> Values<'a> {
         let tip = robot.tip_pose(&self.kinematics).unwrap();
         (self.cables.lengths().unwrap(), tip, gravity_energy)
     }
+
+    /// End-effector displacement and rotation vector from `q0` to `q`, base frame.
+    pub fn motion(&mut self, q0: &[f64], q: &[f64]) -> Vector6<f64> {
+        let a = self.at(q0).1;
+        let b = self.at(q).1;
+        let dp = b.translation.vector - a.translation.vector;
+        let dr = (b.rotation * a.rotation.inverse()).scaled_axis();
+        Vector6::new(dp[0], dp[1], dp[2], dr[0], dr[1], dr[2])
+    }
 }
 
 /// The elastic-cable model frozen at a reference equilibrium.
@@ -121,6 +130,36 @@ impl<'a> Elastic<'a> {
 
     /// `V(Q)` (with the load `F0 − δw`) and the tip's rotation.
     pub fn energy(&mut self, q: &[f64], dw: &Vector6<f64>) -> (f64, Rotation3<f64>) {
+        Potential::energy(self, q, dw)
+    }
+
+    /// `R(Q)`: [`Potential::residual`].
+    pub fn residual(&mut self, q: &[f64], dw: &Vector6<f64>) -> Vec<f64> {
+        Potential::residual(self, q, dw)
+    }
+
+    /// Newton's matrix: [`Potential::newton_matrix`].
+    pub fn newton_matrix(&mut self, q: &[f64]) -> Mat<f64> {
+        Potential::newton_matrix(self, q)
+    }
+
+    /// The equilibrium under `δw`: [`Potential::solve`].
+    pub fn solve(&mut self, q0: &[f64], jac: &Mat<f64>, dw: &Vector6<f64>) -> Vec<f64> {
+        Potential::solve(self, q0, jac, dw)
+    }
+
+    /// End-effector displacement and rotation vector from `q0` to `q`, base frame.
+    pub fn motion(&mut self, q0: &[f64], q: &[f64]) -> Vector6<f64> {
+        self.values.motion(q0, q)
+    }
+}
+
+impl Potential for Elastic<'_> {
+    fn load(&self) -> Vector6<f64> {
+        self.load
+    }
+
+    fn energy(&mut self, q: &[f64], dw: &Vector6<f64>) -> (f64, Rotation3<f64>) {
         let force = (self.load - dw).fixed_rows::<3>(0).into_owned();
         let (lengths, tip, gravity_energy) = self.values.at(q);
         let cables: f64 = lengths
@@ -133,10 +172,21 @@ impl<'a> Elastic<'a> {
             .sum();
         (gravity_energy + cables + force.dot(&tip.translation.vector), tip.rotation)
     }
+}
+
+/// A potential-energy model of the arm under the load `F0 − δw` (gravity, elastic cables, the
+/// load's force part), from which the residual, Newton's matrix and the solve follow: the
+/// whole-cable springs of [`Elastic`], or a test's own (segment springs in the stick regime).
+pub trait Potential {
+    /// `F0`, the wrench the end-effector exerts at the reference (base frame).
+    fn load(&self) -> Vector6<f64>;
+
+    /// `V(Q)` with the load `F0 − δw`, and the tip's rotation.
+    fn energy(&mut self, q: &[f64], dw: &Vector6<f64>) -> (f64, Rotation3<f64>);
 
     /// `R(Q) = −∂V/∂Q − (F0 − δw)_m · ω(Q)`, zero at equilibrium (N m).
-    pub fn residual(&mut self, q: &[f64], dw: &Vector6<f64>) -> Vec<f64> {
-        let moment = (self.load - dw).fixed_rows::<3>(3).into_owned();
+    fn residual(&mut self, q: &[f64], dw: &Vector6<f64>) -> Vec<f64> {
+        let moment = (self.load() - dw).fixed_rows::<3>(3).into_owned();
         let h = H_VALUES;
         let mut qs = q.to_vec();
         (0..q.len())
@@ -162,7 +212,7 @@ impl<'a> Elastic<'a> {
     }
 
     /// Newton's matrix `∂R/∂Q` at `q`, by central differences of `R`.
-    pub fn newton_matrix(&mut self, q: &[f64]) -> Mat<f64> {
+    fn newton_matrix(&mut self, q: &[f64]) -> Mat<f64> {
         let n = q.len();
         let mut jac = Mat::<f64>::zeros(n, n);
         let mut qs = q.to_vec();
@@ -180,7 +230,7 @@ impl<'a> Elastic<'a> {
     }
 
     /// The equilibrium under `δw` near `q0`: Newton's method with the fixed matrix `jac`.
-    pub fn solve(&mut self, q0: &[f64], jac: &Mat<f64>, dw: &Vector6<f64>) -> Vec<f64> {
+    fn solve(&mut self, q0: &[f64], jac: &Mat<f64>, dw: &Vector6<f64>) -> Vec<f64> {
         let n = q0.len();
         let lu = jac.partial_piv_lu();
         let norm = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -217,15 +267,6 @@ impl<'a> Elastic<'a> {
             "Newton did not converge: residual {:.3e} at {q:?} (from {q0:?}, δw {dw:?})",
             norm(&r)
         );
-    }
-
-    /// End-effector displacement and rotation vector from `q0` to `q`, base frame.
-    pub fn motion(&mut self, q0: &[f64], q: &[f64]) -> Vector6<f64> {
-        let a = self.values.at(q0).1;
-        let b = self.values.at(q).1;
-        let dp = b.translation.vector - a.translation.vector;
-        let dr = (b.rotation * a.rotation.inverse()).scaled_axis();
-        Vector6::new(dp[0], dp[1], dp[2], dr[0], dr[1], dr[2])
     }
 }
 

@@ -1,0 +1,351 @@
+//! The stick load limit (spec §9, #27) against a nonlinear stick model built from library
+//! *values* only: every segment a spring `E A/ℓ_s` frozen at the pose with the tensions the
+//! history left, gravity and the load `F0 − δw` (the potential of
+//! `sinew_testkit::newton::Potential`), solved by Newton's method under the wrench increment
+//! `δw = α u` at 0.98 and 1.02 times the limit. Below it every hole is inside its band; above it
+//! the hole the library names is past the edge it names. After a pull history, along a
+//! direction whose limit is 0, the holes named slide at once: a small increment already
+//! pushes each past its edge.
+//!
+//! What the model reads from the library: segment lengths and wrap angles (values, at any `Q`),
+//! poses, masses, and at the reference the tensions, `K_stick`, `K_W` and `J_x` (only to
+//! compute the limit being checked, and Newton's matrix is a central difference of the
+//! residual). A wrong `δT_s`, `∇θ`, band edge or sign therefore shows here.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use faer::Mat;
+use nalgebra::{Rotation3, Vector6};
+use sinew_robot::{Robot, RobotData};
+use sinew_routing::{
+    FrictionData, FrictionModel, Order, PatternModel, Routing, RoutingData, Slip,
+    compute_cable_geometry, compute_capstan_weights, compute_friction_geometry,
+};
+use sinew_statics::{TensionChoice, TensionPolicy, distribute_with_policy, slip_equilibrium_set};
+use sinew_stiffness::{
+    ArmStiffness, ArmStiffnessData, BandEdge, FrictionStiffnessData, History, StickLoadLimit,
+    StiffnessError, base_directions, stick_load_limits, stick_stiffness,
+};
+use sinew_testkit::cdhrm5;
+use sinew_testkit::newton::{Potential, Values};
+
+const MU: f64 = 0.1;
+/// E4's load: 5 N along +y at the tip (base frame).
+const F0: [f64; 6] = [0.0, 5.0, 0.0, 0.0, 0.0, 0.0];
+
+/// The friction geometry at `q` (lengths, directions, wrap angles), weights of `slip` if any.
+fn friction_at(
+    robot: &Robot,
+    routing: &Routing,
+    model: &FrictionModel,
+    q: &[f64],
+    slip: Option<Slip>,
+) -> (RoutingData, FrictionData) {
+    let mut rdata = RobotData::new(robot);
+    let mut geometry = RoutingData::new(routing);
+    compute_cable_geometry(routing, robot, &mut rdata, &mut geometry, q, Order::Hessians).unwrap();
+    let mut friction = FrictionData::new(model);
+    compute_friction_geometry(model, routing, &geometry, &mut friction).unwrap();
+    if let Some(slip) = slip {
+        compute_capstan_weights(model, &mut friction, slip).unwrap();
+    }
+    (geometry, friction)
+}
+
+/// The stick model frozen at the reference: per cable, each segment's length, tension and
+/// spring there.
+struct Stick<'a> {
+    robot: &'a Robot,
+    routing: &'a Routing,
+    model: &'a FrictionModel,
+    values: Values<'a>,
+    load: Vector6<f64>,
+    /// Per cable and segment: `(ℓ_s, T_s, E A/ℓ_s)` at the reference.
+    frozen: Vec<Vec<(f64, f64, f64)>>,
+}
+
+impl<'a> Stick<'a> {
+    fn new(
+        robot: &'a Robot,
+        routing: &'a Routing,
+        model: &'a FrictionModel,
+        q: &[f64],
+        segment_tensions: &[Vec<f64>],
+    ) -> Stick<'a> {
+        let (_, friction) = friction_at(robot, routing, model, q, None);
+        let ea = routing.youngs_modulus() * routing.area();
+        let frozen = segment_tensions
+            .iter()
+            .enumerate()
+            .map(|(c, t)| {
+                let l = friction.lengths(model, c).unwrap();
+                l.iter().zip(t).map(|(&l, &t)| (l, t, ea / l)).collect()
+            })
+            .collect();
+        let values = Values::new(robot, routing);
+        Stick { robot, routing, model, values, load: Vector6::from(F0), frozen }
+    }
+
+    /// Per cable: every segment's tension and every hole's wrap angle at `q`.
+    fn state(&self, q: &[f64]) -> Vec<(Vec<f64>, Vec<f64>)> {
+        let (_, friction) = friction_at(self.robot, self.routing, self.model, q, None);
+        self.frozen
+            .iter()
+            .enumerate()
+            .map(|(c, frozen)| {
+                let l = friction.lengths(self.model, c).unwrap();
+                let t = frozen.iter().zip(l).map(|(&(l0, t0, k), &l)| t0 + k * (l - l0)).collect();
+                (t, friction.wrap_angles(self.model, c).unwrap().to_vec())
+            })
+            .collect()
+    }
+
+    /// `g⁻` and `g⁺` of every hole at `q`, cable by cable: `(cable, hole, g⁻, g⁺, scale)`.
+    fn bands(&self, q: &[f64]) -> Vec<(usize, usize, f64, f64, f64)> {
+        let mut out = Vec::new();
+        for (c, (t, theta)) in self.state(q).into_iter().enumerate() {
+            for (k, &theta) in theta.iter().enumerate() {
+                let (lo, hi) = ((-MU * theta).exp(), (MU * theta).exp());
+                out.push((c, k, t[k + 1] - t[k] * lo, t[k] * hi - t[k + 1], t[k] + t[k + 1]));
+            }
+        }
+        out
+    }
+}
+
+impl Potential for Stick<'_> {
+    fn load(&self) -> Vector6<f64> {
+        self.load
+    }
+
+    fn energy(&mut self, q: &[f64], dw: &Vector6<f64>) -> (f64, Rotation3<f64>) {
+        let force = (self.load - dw).fixed_rows::<3>(0).into_owned();
+        let (_, tip, gravity) = self.values.at(q);
+        let (tip, mut v) = (tip, gravity + force.dot(&tip.translation.vector));
+        let (_, friction) = friction_at(self.robot, self.routing, self.model, q, None);
+        for (c, frozen) in self.frozen.iter().enumerate() {
+            let l = friction.lengths(self.model, c).unwrap();
+            for (&(l0, t0, k), &l) in frozen.iter().zip(l).skip(1) {
+                let d = l - l0;
+                v += t0 * d + 0.5 * k * d * d;
+            }
+        }
+        (v, tip.rotation)
+    }
+}
+
+/// Everything at the reference for one routing model and history.
+struct Setup {
+    robot: Robot,
+    routing: Routing,
+    model: FrictionModel,
+    actuator: Vec<f64>,
+    segments: Vec<Vec<f64>>,
+    limits: Vec<StickLoadLimit>,
+}
+
+fn setup(pattern: PatternModel, history: History) -> Setup {
+    let (robot, routing) = cdhrm5::robot_and_routing(pattern);
+    let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
+    let q = cdhrm5::LOADED_POSE;
+    let f0 = Vector6::from(F0);
+    let arm = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut data = ArmStiffnessData::new(&arm);
+    arm.evaluate_joints(&mut data, &q, &f0, TensionChoice::Levels(&[0.5; 5])).unwrap();
+    let (geometry, friction) = friction_at(&robot, &routing, &model, &q, history.slip());
+    // Actuator tensions that balance the load with the history's segment tensions: equal along
+    // each cable (the frictionless statics), or the pull distribution (the slip statics on J̃).
+    let actuator = match history {
+        History::Equal => data.tensions().to_vec(),
+        _ => {
+            let statics = arm.statics();
+            let set = slip_equilibrium_set(
+                &model,
+                &friction,
+                &data.statics.t0,
+                statics.cable_limits(),
+                statics.joint_groups(),
+            )
+            .unwrap();
+            let names: Vec<String> = routing.cables().iter().map(|c| c.name.clone()).collect();
+            let mut t = vec![0.0; routing.cable_count()];
+            distribute_with_policy(
+                &set,
+                TensionPolicy::Safest,
+                statics.joint_groups(),
+                &names,
+                &mut t,
+            )
+            .unwrap();
+            t
+        }
+    };
+    let segments: Vec<Vec<f64>> = (0..routing.cable_count())
+        .map(|c| {
+            let h = friction.lengths(&model, c).unwrap().len();
+            match history {
+                History::Equal => vec![actuator[c]; h],
+                _ => friction.weights(&model, c).unwrap().iter().map(|w| actuator[c] * w).collect(),
+            }
+        })
+        .collect();
+    let mut stick = FrictionStiffnessData::new(&model);
+    stick_stiffness(&model, &routing, &geometry, &friction, history, &actuator, &mut stick)
+        .unwrap();
+    let k_w = data.k_w().to_owned();
+    let j_x = data.j_x().to_owned();
+    let limits = stick_load_limits(
+        &model,
+        &routing,
+        &friction,
+        history,
+        &actuator,
+        (stick.stiffness().unwrap(), k_w.as_ref(), j_x.as_ref()),
+        &base_directions(),
+    )
+    .unwrap();
+    Setup { robot, routing, model, actuator, segments, limits }
+}
+
+/// The least `g / scale` over every hole and edge, and that of one hole's edge.
+fn least_and_named(
+    bands: &[(usize, usize, f64, f64, f64)],
+    c: usize,
+    k: usize,
+    edge: BandEdge,
+) -> (f64, f64) {
+    let least = bands.iter().map(|b| b.2.min(b.3) / b.4).fold(f64::INFINITY, f64::min);
+    let b = bands.iter().find(|b| b.0 == c && b.1 == k).unwrap();
+    let named = match edge {
+        BandEdge::Lower => b.2 / b.4,
+        BandEdge::Upper => b.3 / b.4,
+    };
+    (least, named)
+}
+
+#[test]
+fn from_equal_tensions_the_limit_is_positive_and_right_on_both_sides() {
+    for pattern in cdhrm5::MODELS {
+        let s = setup(pattern, History::Equal);
+        let q = cdhrm5::LOADED_POSE;
+        let mut stick = Stick::new(&s.robot, &s.routing, &s.model, &q, &s.segments);
+        // The reference is an equilibrium of the nonlinear model (the library's statics, signs
+        // and tensions agree with it): Newton does not move.
+        let jac = stick.newton_matrix(&q);
+        let rest = stick.solve(&q, &jac, &Vector6::zeros());
+        let moved = rest.iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(moved < 1e-9, "{pattern:?}: the reference is not an equilibrium ({moved:.1e} rad)");
+        for limit in &s.limits {
+            let u = limit.direction;
+            assert!(limit.at_once.is_empty(), "{pattern:?} {u:?}: {:?}", limit.at_once);
+            let first = limit.first.expect("some edge is approached");
+            let alpha = limit.magnitude;
+            assert!(alpha > 0.0 && alpha.is_finite(), "{pattern:?} {u:?}: {alpha}");
+            assert!(!first.kinked);
+            let below = stick.solve(&q, &jac, &(0.98 * alpha * u));
+            let below = stick.bands(&below);
+            let above = stick.solve(&q, &jac, &(1.02 * alpha * u));
+            let above = stick.bands(&above);
+            let (least_below, _) = least_and_named(&below, first.cable, first.hole, first.edge);
+            let (_, named_above) = least_and_named(&above, first.cable, first.hole, first.edge);
+            println!(
+                "{pattern:?} u = {:?}: limit {alpha:.4} (cable {}, hole {}, {:?}); least band room \
+                 at 0.98×: {least_below:.2e}, the named edge at 1.02×: {named_above:.2e}",
+                u.as_slice(),
+                first.cable,
+                first.hole,
+                first.edge
+            );
+            assert!(least_below > 0.0, "{pattern:?} {u:?}: a band is broken below the limit");
+            assert!(named_above < 0.0, "{pattern:?} {u:?}: the named edge holds above the limit");
+        }
+    }
+}
+
+#[test]
+fn after_a_pull_the_holes_pushed_over_their_edge_slide_at_once() {
+    for pattern in cdhrm5::MODELS {
+        let s = setup(pattern, History::Pull);
+        let q = cdhrm5::LOADED_POSE;
+        let mut stick = Stick::new(&s.robot, &s.routing, &s.model, &q, &s.segments);
+        let jac = stick.newton_matrix(&q);
+        // Every hole of a pulled cable sits on its lower edge.
+        for b in stick.bands(&q) {
+            assert!(b.2.abs() <= 1e-12 * b.4, "{pattern:?}: hole {b:?} is not on its lower edge");
+        }
+        let zero: Vec<&StickLoadLimit> = s.limits.iter().filter(|l| l.magnitude == 0.0).collect();
+        assert!(!zero.is_empty(), "{pattern:?}: no direction slides at once after a pull");
+        for limit in &s.limits {
+            let u = limit.direction;
+            if limit.magnitude > 0.0 {
+                assert!(limit.at_once.is_empty());
+                continue;
+            }
+            // 0.01 N (or N m) along u: far above Newton's floor, far below any band's width.
+            let moved = stick.solve(&q, &jac, &(0.01 * u));
+            let bands = stick.bands(&moved);
+            for e in &limit.at_once {
+                assert_eq!(e.edge, BandEdge::Lower, "{pattern:?} {u:?}: {e:?}");
+                let (_, named) = least_and_named(&bands, e.cable, e.hole, e.edge);
+                assert!(named < 0.0, "{pattern:?} {u:?}: {e:?} holds ({named:.1e})");
+            }
+            // And the holes not named stay on their edge or move inside it.
+            for b in &bands {
+                let named = limit.at_once.iter().any(|e| e.cable == b.0 && e.hole == b.1);
+                assert!(named || b.2 >= -1e-9 * b.4, "{pattern:?} {u:?}: hole {b:?} not named");
+            }
+            println!(
+                "{pattern:?} u = {:?}: {} holes slide at once",
+                u.as_slice(),
+                limit.at_once.len()
+            );
+        }
+        assert!(s.actuator.iter().all(|t| *t > 0.0));
+    }
+}
+
+#[test]
+fn bad_input_is_refused() {
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
+    let q = cdhrm5::LOADED_POSE;
+    let n = routing.dof();
+    let eye = Mat::<f64>::identity(n, n);
+    let zero = Mat::<f64>::zeros(n, n);
+    let j_x = Mat::<f64>::from_fn(6, n, |i, j| if i == j { 1.0 } else { 0.0 });
+    let t = vec![100.0; routing.cable_count()];
+    let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
+    let (_, friction) = friction_at(&robot, &routing, &model, &q, None);
+    let call = |model: &FrictionModel, history, k: &Mat<f64>, u: Vector6<f64>| {
+        stick_load_limits(
+            model,
+            &routing,
+            &friction,
+            history,
+            &t,
+            (k.as_ref(), zero.as_ref(), j_x.as_ref()),
+            &[u],
+        )
+        .map(|_| ())
+        .map_err(Box::new)
+    };
+    let u = Vector6::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    assert!(call(&model, History::Equal, &eye, u).is_ok());
+    for bad in [Vector6::zeros(), Vector6::new(f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0)] {
+        let e = call(&model, History::Equal, &eye, bad).unwrap_err();
+        assert!(matches!(*e, StiffnessError::InvalidWrenchDirection { .. }), "{e}");
+    }
+    let unstable = Mat::<f64>::from_fn(n, n, |i, j| match (i == j, i) {
+        (true, 3) => -2.0,
+        (true, _) => 1.0,
+        _ => 0.0,
+    });
+    match *call(&model, History::Equal, &unstable, u).unwrap_err() {
+        StiffnessError::Unstable { min_eigenvalue } => assert_eq!(min_eigenvalue, -2.0),
+        e => panic!("{e}"),
+    }
+    // Pull without the pull weights; μ = 0 (no band to stick in).
+    let e = call(&model, History::Pull, &eye, u).unwrap_err();
+    assert!(matches!(*e, StiffnessError::WrongCapstanWeights { .. }), "{e}");
+    let frictionless = FrictionModel::new(&routing);
+    let e = call(&frictionless, History::Equal, &eye, u).unwrap_err();
+    assert!(matches!(*e, StiffnessError::StickWithoutFriction { cable: 0 }), "{e}");
+}
