@@ -54,6 +54,25 @@ pub enum StiffnessError {
         /// The direction passed (force, then moment).
         direction: [f64; 6],
     },
+    /// The directional response's active-set passes found no consistent set of sliding holes
+    /// (they cycled), or a sliding set made the increment's system singular.
+    #[error("no consistent set of sliding holes for this direction (after {passes} passes)")]
+    NoConsistentSliding {
+        /// Passes taken (0: the system of one set was singular).
+        passes: usize,
+    },
+    /// The holes that slide under an increment leave a joint stiffness that is not positive
+    /// definite: that sliding combination is itself unstable.
+    #[error(
+        "the arm is unstable with its {holes} sliding holes free (smallest eigenvalue {} N m/rad)",
+        Compact(*.min_eigenvalue)
+    )]
+    UnstableSliding {
+        /// How many holes slide.
+        holes: usize,
+        /// Smallest eigenvalue of the symmetric part of that joint stiffness.
+        min_eigenvalue: f64,
+    },
     /// A stage of the pipeline asked for before the stage it needs: tensions before a pose
     /// ([`crate::ArmStiffness::set_pose`]), the end before tensions
     /// ([`crate::ArmStiffness::set_tensions`]).
@@ -128,10 +147,13 @@ impl StiffnessError {
     pub fn kind(&self) -> ErrorKind {
         // No wildcard: a new variant must be classified here.
         match self {
-            StiffnessError::Unstable { .. } => ErrorKind::Unstable,
+            StiffnessError::Unstable { .. } | StiffnessError::UnstableSliding { .. } => {
+                ErrorKind::Unstable
+            }
             StiffnessError::RankDeficient { .. } => ErrorKind::RankDeficient,
             StiffnessError::NonFinite { .. }
             | StiffnessError::Eigen
+            | StiffnessError::NoConsistentSliding { .. }
             | StiffnessError::WorkspaceMismatch { .. } => ErrorKind::Numerical,
             StiffnessError::DimensionMismatch { .. }
             | StiffnessError::InvalidDirection { .. }

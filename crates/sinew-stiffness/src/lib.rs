@@ -34,11 +34,13 @@ mod arm;
 mod cholesky;
 mod colmajor;
 mod data;
+mod directional;
 mod ellipsoid;
 mod end;
 mod end_data;
 mod error;
 mod friction;
+mod holes;
 mod inherent;
 mod joint;
 mod outcome;
@@ -49,16 +51,17 @@ mod structured;
 
 pub use arm::ArmStiffness;
 pub use data::{ArmStiffnessData, EndOutcome, EndSolver};
+pub use directional::{DirectionalResponse, Increment, directional_response, sliding_response};
 pub use ellipsoid::StiffnessEllipsoid;
 pub use end::{end_compliance, end_stiffness, stability_margin};
 pub use end_data::{END_RANK_TOLERANCE, EndStiffnessData, compliance_inverse, has_full_rank};
 pub use error::StiffnessError;
 pub use friction::{FrictionRegime, FrictionStiffnessData, History};
+pub use holes::{BandEdge, HoleEvent};
 pub use joint::{joint_block, joint_stiffness, stiffness_slope};
 pub use outcome::{Outcome, OutcomeNote};
 pub use slip::slip_stiffness;
 pub use stick::stick_stiffness;
 pub use stick_limit::{
-    BandEdge, EDGE_TOLERANCE, HoleEvent, RATE_TOLERANCE, StickLoadLimit, base_directions,
-    stick_load_limits,
+    EDGE_TOLERANCE, RATE_TOLERANCE, StickLoadLimit, base_directions, stick_load_limits,
 };

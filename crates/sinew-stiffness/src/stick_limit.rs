@@ -37,7 +37,8 @@ use sinew_routing::{FrictionData, FrictionModel, Routing};
 
 use crate::end::stability_margin;
 use crate::error::StiffnessError;
-use crate::friction::{History, axial_rigidity, check_weights};
+use crate::friction::History;
+use crate::holes::{BandEdge, Hole, HoleEvent, dot, holes};
 
 /// A hole is on an edge of its band when `g ≤ EDGE_TOLERANCE · (T_k + T_{k+1})`: a pull or
 /// release distribution puts every hole on an edge up to the rounding of `e^{±μθ}` products
@@ -48,29 +49,6 @@ pub const EDGE_TOLERANCE: f64 = 1e-12;
 /// when `|ġ| ≤ RATE_TOLERANCE ·` the sum of its terms' magnitudes: cancellation, as at a hole
 /// inside one body, whose segments keep their lengths and angle.
 pub const RATE_TOLERANCE: f64 = 1e-10;
-
-/// Which edge of a hole's capstan band `T_k e^{−μθ} ≤ T_{k+1} ≤ T_k e^{+μθ}`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum BandEdge {
-    /// `T_{k+1} = T_k e^{−μθ_k}`: the cable slides toward the actuator (as in pull).
-    Lower,
-    /// `T_{k+1} = T_k e^{+μθ_k}`: the cable slides away from the actuator (as in release).
-    Upper,
-}
-
-/// A hole reaching an edge of its band.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct HoleEvent {
-    /// The cable (routing order, 0-based).
-    pub cable: usize,
-    /// The hole, 0-based along the cable from the actuator (between friction segments `hole`
-    /// and `hole + 1`; the anchor has none).
-    pub hole: usize,
-    /// The edge it reaches.
-    pub edge: BandEdge,
-    /// Whether the hole is at the kink `θ ≈ 0` (module docs: its band has no width there).
-    pub kinked: bool,
-}
 
 /// The stick load limit along one direction.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,12 +114,7 @@ pub fn stick_load_limits(
             return Err(StiffnessError::DimensionMismatch { what, expected, got });
         }
     }
-    if let Some(cable) = model.friction_coefficients().iter().position(|&mu| mu <= 0.0) {
-        return Err(StiffnessError::StickWithoutFriction { cable });
-    }
-    if let Some(slip) = history.slip() {
-        check_weights(friction, slip)?;
-    }
+    let holes = holes(model, routing, friction, history, actuator)?;
     if let Some(u) = directions.iter().find(|u| !u.iter().all(|x| x.is_finite()) || u.norm() == 0.0)
     {
         return Err(StiffnessError::InvalidWrenchDirection { direction: (*u).into() });
@@ -157,7 +130,7 @@ pub fn stick_load_limits(
         let rhs = Mat::from_fn(n, 1, |i, _| (0..6).map(|r| j_x[(r, i)] * u[r]).sum::<f64>());
         let dq = lu.solve(rhs);
         let dq: Vec<f64> = (0..n).map(|i| dq[(i, 0)]).collect();
-        out.push(along(model, routing, friction, history, actuator, u, dq)?);
+        out.push(along(model, friction, &holes, u, dq)?);
     }
     Ok(out)
 }
@@ -165,56 +138,36 @@ pub fn stick_load_limits(
 /// The limit along `u`, given its joint motion `dq` per unit `α`.
 fn along(
     model: &FrictionModel,
-    routing: &Routing,
     friction: &FrictionData,
-    history: History,
-    actuator: &[f64],
+    holes: &[Hole],
     u: &Vector6<f64>,
     dq: Vec<f64>,
 ) -> Result<StickLoadLimit, StiffnessError> {
-    let ea = axial_rigidity(routing);
-    let mu = model.friction_coefficients();
     let mut best = (f64::INFINITY, None);
     let mut at_once = Vec::new();
-    for (c, &t_0) in actuator.iter().enumerate() {
-        let lengths = friction.lengths(model, c)?;
-        let weights = match history {
-            History::Equal => None,
-            History::Pull | History::Release => Some(friction.weights(model, c)?),
-        };
-        let tension = |s: usize| weights.map_or(t_0, |w| t_0 * w[s]);
-        // δT_s per unit α: the segment's spring times its stretch; the free length's is 0.
-        let rate = |s: usize| -> Result<f64, StiffnessError> {
+    for h in holes {
+        // δT per unit α of the two segments: spring times stretch (the free length's is 0).
+        let rate = |s: usize, spring: f64| -> Result<f64, StiffnessError> {
             if s == 0 {
                 return Ok(0.0);
             }
-            let j_s = friction.segment_jacobian(model, c, s)?;
-            let stretch: f64 = j_s.values.iter().zip(j_s.dofs).map(|(v, d)| v * dq[d]).sum();
-            Ok(ea / lengths[s] * stretch)
+            Ok(spring * dot(&friction.segment_jacobian(model, h.cable, s)?, &dq))
         };
-        let (angles, kinked) = (friction.wrap_angles(model, c)?, friction.kinked(model, c)?);
-        for (k, (&theta, &kinked)) in angles.iter().zip(kinked).enumerate() {
-            let grad = friction.wrap_gradient(model, c, k)?;
-            let dtheta: f64 = grad.values.iter().zip(grad.dofs).map(|(v, d)| v * dq[d]).sum();
-            let (t_k, t_next) = (tension(k), tension(k + 1));
-            let (dt_k, dt_next) = (rate(k)?, rate(k + 1)?);
-            let (lo, hi) = ((-mu[c] * theta).exp(), (mu[c] * theta).exp());
-            let turn = mu[c] * t_k * dtheta;
-            let edges = [
-                (BandEdge::Lower, t_next - t_k * lo, dt_next - lo * (dt_k - turn), lo),
-                (BandEdge::Upper, t_k * hi - t_next, hi * (dt_k + turn) - dt_next, hi),
-            ];
-            for (edge, g, dg, e) in edges {
-                let terms = dt_next.abs() + e * (dt_k.abs() + turn.abs());
-                if dg >= -RATE_TOLERANCE * terms {
-                    continue;
-                }
-                let event = HoleEvent { cable: c, hole: k, edge, kinked };
-                if g <= EDGE_TOLERANCE * (t_k + t_next) {
-                    at_once.push(event);
-                } else if g / -dg < best.0 {
-                    best = (g / -dg, Some(event));
-                }
+        let dt_k = rate(h.hole, h.springs[0])?;
+        let dt_next = rate(h.hole + 1, h.springs[1])?;
+        let dtheta = dot(&friction.wrap_gradient(model, h.cable, h.hole)?, &dq);
+        for edge in [BandEdge::Lower, BandEdge::Upper] {
+            let (a, b, d) = h.rate_coefficients(edge);
+            let dg = a * dt_next + b * dt_k + d * dtheta;
+            let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
+            if dg >= -RATE_TOLERANCE * terms {
+                continue;
+            }
+            let g = h.room(edge);
+            if g <= EDGE_TOLERANCE * h.scale() {
+                at_once.push(h.event(edge));
+            } else if g / -dg < best.0 {
+                best = (g / -dg, Some(h.event(edge)));
             }
         }
     }

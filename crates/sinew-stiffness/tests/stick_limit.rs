@@ -14,6 +14,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
+use faer::linalg::solvers::Solve;
 use nalgebra::{Rotation3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{
@@ -22,8 +23,9 @@ use sinew_routing::{
 };
 use sinew_statics::{TensionChoice, TensionPolicy, distribute_with_policy, slip_equilibrium_set};
 use sinew_stiffness::{
-    ArmStiffness, ArmStiffnessData, BandEdge, FrictionStiffnessData, History, StickLoadLimit,
-    StiffnessError, base_directions, stick_load_limits, stick_stiffness,
+    ArmStiffness, ArmStiffnessData, BandEdge, DirectionalResponse, FrictionStiffnessData, History,
+    HoleEvent, Increment, StickLoadLimit, StiffnessError, base_directions, directional_response,
+    sliding_response, slip_stiffness, stick_load_limits, stick_stiffness,
 };
 use sinew_testkit::cdhrm5;
 use sinew_testkit::newton::{Potential, Values};
@@ -141,6 +143,17 @@ struct Setup {
     actuator: Vec<f64>,
     segments: Vec<Vec<f64>>,
     limits: Vec<StickLoadLimit>,
+    friction: FrictionData,
+    geometry: RoutingData,
+    k_stick: Mat<f64>,
+    k_w: Mat<f64>,
+    j_x: Mat<f64>,
+}
+
+impl Setup {
+    fn increment(&self) -> Increment<'_> {
+        (self.k_stick.as_ref(), self.k_w.as_ref(), self.j_x.as_ref())
+    }
 }
 
 fn setup(pattern: PatternModel, history: History) -> Setup {
@@ -203,7 +216,20 @@ fn setup(pattern: PatternModel, history: History) -> Setup {
         &base_directions(),
     )
     .unwrap();
-    Setup { robot, routing, model, actuator, segments, limits }
+    let k_stick = stick.stiffness().unwrap().to_owned();
+    Setup {
+        robot,
+        routing,
+        model,
+        actuator,
+        segments,
+        limits,
+        friction,
+        geometry,
+        k_stick,
+        k_w,
+        j_x,
+    }
 }
 
 /// The least `g / scale` over every hole and edge, and that of one hole's edge.
@@ -348,4 +374,176 @@ fn bad_input_is_refused() {
     let frictionless = FrictionModel::new(&routing);
     let e = call(&frictionless, History::Equal, &eye, u).unwrap_err();
     assert!(matches!(*e, StiffnessError::StickWithoutFriction { cable: 0 }), "{e}");
+}
+
+/// `(K + K_W)⁻¹ J_xᵀ u`.
+fn response(k: &Mat<f64>, k_w: &Mat<f64>, j_x: &Mat<f64>, u: &Vector6<f64>) -> Vec<f64> {
+    let n = k.nrows();
+    let a = Mat::from_fn(n, n, |i, j| k[(i, j)] + k_w[(i, j)]);
+    let rhs = Mat::from_fn(n, 1, |i, _| (0..6).map(|r| j_x[(r, i)] * u[r]).sum::<f64>());
+    let x = a.partial_piv_lu().solve(rhs);
+    (0..n).map(|i| x[(i, 0)]).collect()
+}
+
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let d = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    d / b.iter().map(|x| x.abs()).fold(0.0, f64::max)
+}
+
+#[test]
+fn the_sliding_system_is_stick_with_no_hole_and_slip_with_every_hole() {
+    // No hole sliding: the stick regime's response. Every hole sliding at its lower edge after
+    // a pull: the pull slip regime's, whose K_slip is derived apart (slip.rs) and checked
+    // against the central difference of a nonlinear torque (tests/friction.rs).
+    for pattern in cdhrm5::MODELS {
+        let s = setup(pattern, History::Pull);
+        let mut slip = FrictionStiffnessData::new(&s.model);
+        let args = (&s.model, &s.routing, &s.geometry, &s.friction);
+        slip_stiffness(args.0, args.1, args.2, args.3, Slip::Pull, &s.actuator, &mut slip).unwrap();
+        let k_slip = slip.stiffness().unwrap().to_owned();
+        let every: Vec<HoleEvent> = (0..s.routing.cable_count())
+            .flat_map(|c| {
+                let n = s.friction.wrap_angles(&s.model, c).unwrap().len();
+                (0..n).map(move |k| HoleEvent {
+                    cable: c,
+                    hole: k,
+                    edge: BandEdge::Lower,
+                    kinked: false,
+                })
+            })
+            .collect();
+        let mut worst = [0.0_f64; 2];
+        for u in base_directions() {
+            let call = |sliding: &[HoleEvent]| {
+                let h = History::Pull;
+                let (m, r, f, t) = (&s.model, &s.routing, &s.friction, &s.actuator);
+                sliding_response(m, r, f, h, t, s.increment(), &u, sliding).unwrap()
+            };
+            let (dq, flux) = call(&[]);
+            assert!(flux.is_empty());
+            worst[0] = worst[0].max(rel_diff(&dq, &response(&s.k_stick, &s.k_w, &s.j_x, &u)));
+            let (dq, flux) = call(&every);
+            worst[1] = worst[1].max(rel_diff(&dq, &response(&k_slip, &s.k_w, &s.j_x, &u)));
+            assert_eq!(flux.len(), every.len());
+        }
+        println!(
+            "{pattern:?}: |δQ − δQ_stick| {:.1e}, |δQ − δQ_slip| {:.1e} (relative)",
+            worst[0], worst[1]
+        );
+        assert!(worst[0] <= 1e-12, "{pattern:?}: stick {:.1e}", worst[0]);
+        assert!(worst[1] <= 1e-8, "{pattern:?}: slip {:.1e}", worst[1]);
+    }
+}
+
+#[test]
+fn the_directional_response_is_consistent_and_shows_hysteresis() {
+    for pattern in cdhrm5::MODELS {
+        // From equal tensions no hole is on an edge: both directions are the stick response.
+        let s = setup(pattern, History::Equal);
+        for u in base_directions() {
+            let (m, r, f, t) = (&s.model, &s.routing, &s.friction, &s.actuator);
+            let [plus, minus] =
+                directional_response(m, r, f, History::Equal, t, s.increment(), &u).unwrap();
+            let dq = response(&s.k_stick, &s.k_w, &s.j_x, &u);
+            assert!(plus.sliding.is_empty() && minus.sliding.is_empty());
+            assert_eq!(plus.passes, 1);
+            assert!(rel_diff(&plus.joint_motion, &dq) <= 1e-12);
+            assert!((plus.compliance - minus.compliance).abs() <= 1e-12 * plus.compliance);
+        }
+        // After a pull: some holes slide, the way their edge allows; every hole that sticks
+        // stays inside its band and every one that slides keeps to its edge, recomputed here
+        // from δQ and the fluxes (δT_s = k_s (J_s δQ − φ_{s−1} + φ_s)); sliding only softens.
+        let s = setup(pattern, History::Pull);
+        let mut hysteresis = 0.0_f64;
+        for u in base_directions().into_iter().step_by(2) {
+            let (m, r, f, t) = (&s.model, &s.routing, &s.friction, &s.actuator);
+            let both = directional_response(m, r, f, History::Pull, t, s.increment(), &u).unwrap();
+            let stick_compliance = {
+                let dq = response(&s.k_stick, &s.k_w, &s.j_x, &u);
+                (0..6)
+                    .map(|r| u[r] * (0..10).map(|i| s.j_x[(r, i)] * dq[i]).sum::<f64>())
+                    .sum::<f64>()
+            };
+            for one in &both {
+                assert!(
+                    !one.sliding.is_empty(),
+                    "{pattern:?} {u:?}: a pull leaves every hole on an edge"
+                );
+                for (e, f) in one.sliding.iter().zip(&one.flux) {
+                    assert_eq!(e.edge, BandEdge::Lower);
+                    assert!(
+                        *f <= 0.0,
+                        "{pattern:?}: {e:?} slides away from the actuator ({f:.1e})"
+                    );
+                }
+                assert!(
+                    one.compliance >= stick_compliance * (1.0 - 1e-12),
+                    "{pattern:?}: stiffer than stick"
+                );
+                assert!((one.stiffness * one.compliance - 1.0).abs() < 1e-15);
+                check_bands(&s, one);
+            }
+            hysteresis = hysteresis
+                .max((both[0].compliance - both[1].compliance).abs() / both[0].compliance);
+            println!(
+                "{pattern:?} u = {:?}: compliance +u {:.4e} ({} sliding, {} passes), −u {:.4e} ({} sliding); stick {:.4e}",
+                u.as_slice(),
+                both[0].compliance,
+                both[0].sliding.len(),
+                both[0].passes,
+                both[1].compliance,
+                both[1].sliding.len(),
+                stick_compliance
+            );
+        }
+        assert!(hysteresis > 1e-3, "{pattern:?}: ±u give the same compliance ({hysteresis:.1e})");
+    }
+}
+
+/// Every hole's lower-edge rate `ġ⁻` under the response, from its `δQ` and fluxes: 0 where the
+/// hole slides, ≥ 0 where it sticks (after a pull every hole is on its lower edge).
+fn check_bands(s: &Setup, one: &DirectionalResponse) {
+    let ea = s.routing.youngs_modulus() * s.routing.area();
+    let dot = |row: sinew_routing::DofRow<'_>| {
+        row.values.iter().zip(row.dofs).map(|(v, d)| v * one.joint_motion[d]).sum::<f64>()
+    };
+    for c in 0..s.routing.cable_count() {
+        let l = s.friction.lengths(&s.model, c).unwrap();
+        let theta = s.friction.wrap_angles(&s.model, c).unwrap();
+        let phi = |k: usize| {
+            one.sliding
+                .iter()
+                .zip(&one.flux)
+                .find(|(e, _)| (e.cable, e.hole) == (c, k))
+                .map_or(0.0, |(_, f)| *f)
+        };
+        let rate = |s_: usize| {
+            let stretch = if s_ == 0 {
+                0.0
+            } else {
+                dot(s.friction.segment_jacobian(&s.model, c, s_).unwrap())
+            };
+            let gained = if s_ == 0 { 0.0 } else { phi(s_ - 1) } - phi(s_);
+            ea / l[s_] * (stretch - gained)
+        };
+        for k in 0..theta.len() {
+            let (t_k, lo) = (s.segments[c][k], (-MU * theta[k]).exp());
+            let dtheta = dot(s.friction.wrap_gradient(&s.model, c, k).unwrap());
+            let (dt_k, dt_next) = (rate(k), rate(k + 1));
+            let g = dt_next - lo * (dt_k - MU * t_k * dtheta);
+            let terms = dt_next.abs() + lo * (dt_k.abs() + (MU * t_k * dtheta).abs());
+            let slides = one.sliding.iter().any(|e| (e.cable, e.hole) == (c, k));
+            if slides {
+                assert!(
+                    g.abs() <= 1e-9 * terms.max(1e-300),
+                    "cable {c} hole {k}: slides off its edge ({g:.1e})"
+                );
+            } else {
+                assert!(
+                    g >= -1e-9 * terms,
+                    "cable {c} hole {k}: pushed over its edge ({g:.1e}) but sticks"
+                );
+            }
+        }
+    }
 }
