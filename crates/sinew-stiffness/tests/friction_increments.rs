@@ -1,16 +1,22 @@
-//! The stick load limit (spec §9, #27) against a nonlinear stick model built from library
-//! *values* only: every segment a spring `E A/ℓ_s` frozen at the pose with the tensions the
-//! history left, gravity and the load `F0 − δw` (the potential of
-//! `sinew_testkit::newton::Potential`), solved by Newton's method under the wrench increment
-//! `δw = α u` at 0.98 and 1.02 times the limit. Below it every hole is inside its band; above it
-//! the hole the library names is past the edge it names. After a pull history, along a
-//! direction whose limit is 0, the holes named slide at once: a small increment already
-//! pushes each past its edge.
+//! A wrench increment after a history, with friction at the holes (spec §9, #27): the stick
+//! load limit and the directional response, against a nonlinear model built from library
+//! *values* only. Every piece of cable is a spring `E A/ℓ_s` frozen at the pose with the
+//! tensions the history left; gravity and the load `F0 − δw` complete the potential
+//! (`sinew_testkit::newton::Potential`), solved by Newton's method.
+//!
+//! - **Stick load limit:** at 0.98 times the limit every hole is inside its band; at 1.02 times
+//!   the hole the library names is past the edge it names. After a pull, along a direction
+//!   whose limit is 0, a small increment pushes each hole named past its edge.
+//! - **Directional response:** the linear system of a sliding set is the stick response with no
+//!   hole and the pull slip regime's (`K_slip`, derived apart) with every hole; along ±(the
+//!   load), the nonlinear model with the holes the library says slide free to pass cable at
+//!   their edge moves the tip by `ε · compliance` to first order, with those holes passing cable
+//!   toward the actuator and every other hole inside its band.
 //!
 //! What the model reads from the library: segment lengths and wrap angles (values, at any `Q`),
 //! poses, masses, and at the reference the tensions, `K_stick`, `K_W` and `J_x` (only to
-//! compute the limit being checked, and Newton's matrix is a central difference of the
-//! residual). A wrong `δT_s`, `∇θ`, band edge or sign therefore shows here.
+//! compute what is checked; Newton's matrices are central differences of the residual). A
+//! wrong `δT_s`, `∇θ`, band edge, flux or sign therefore shows here.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
@@ -63,6 +69,9 @@ struct Stick<'a> {
     load: Vector6<f64>,
     /// Per cable and segment: `(ℓ_s, T_s, E A/ℓ_s)` at the reference.
     frozen: Vec<Vec<(f64, f64, f64)>>,
+    /// Per cable and segment: the unstretched length gained since the reference, `δm_s`
+    /// (0 while every hole sticks; [`Stick::set_flux`]).
+    material: Vec<Vec<f64>>,
 }
 
 impl<'a> Stick<'a> {
@@ -84,7 +93,20 @@ impl<'a> Stick<'a> {
             })
             .collect();
         let values = Values::new(robot, routing);
-        Stick { robot, routing, model, values, load: Vector6::from(F0), frozen }
+        let material = segment_tensions.iter().map(|t| vec![0.0; t.len()]).collect();
+        Stick { robot, routing, model, values, load: Vector6::from(F0), frozen, material }
+    }
+
+    /// Cable `phi[i]` passed through hole `sliding[i] = (cable, hole)` (away from the
+    /// actuator): `δm_s = φ_{s−1} − φ_s`.
+    fn set_flux(&mut self, sliding: &[(usize, usize)], phi: &[f64]) {
+        for m in &mut self.material {
+            m.fill(0.0);
+        }
+        for (&(c, k), &f) in sliding.iter().zip(phi) {
+            self.material[c][k] -= f;
+            self.material[c][k + 1] += f;
+        }
     }
 
     /// Per cable: every segment's tension and every hole's wrap angle at `q`.
@@ -95,7 +117,12 @@ impl<'a> Stick<'a> {
             .enumerate()
             .map(|(c, frozen)| {
                 let l = friction.lengths(self.model, c).unwrap();
-                let t = frozen.iter().zip(l).map(|(&(l0, t0, k), &l)| t0 + k * (l - l0)).collect();
+                let t = frozen
+                    .iter()
+                    .zip(l)
+                    .zip(&self.material[c])
+                    .map(|((&(l0, t0, k), &l), m)| t0 + k * (l - l0 - m))
+                    .collect();
                 (t, friction.wrap_angles(self.model, c).unwrap().to_vec())
             })
             .collect()
@@ -126,8 +153,8 @@ impl Potential for Stick<'_> {
         let (_, friction) = friction_at(self.robot, self.routing, self.model, q, None);
         for (c, frozen) in self.frozen.iter().enumerate() {
             let l = friction.lengths(self.model, c).unwrap();
-            for (&(l0, t0, k), &l) in frozen.iter().zip(l).skip(1) {
-                let d = l - l0;
+            for ((&(l0, t0, k), &l), m) in frozen.iter().zip(l).zip(&self.material[c]) {
+                let d = l - l0 - m;
                 v += t0 * d + 0.5 * k * d * d;
             }
         }
@@ -544,6 +571,107 @@ fn check_bands(s: &Setup, one: &DirectionalResponse) {
                     "cable {c} hole {k}: pushed over its edge ({g:.1e}) but sticks"
                 );
             }
+        }
+    }
+}
+
+/// The equilibrium under `dw` with the holes `sliding` (each at its lower edge) free to pass
+/// cable and every other hole sticking: Newton's method on `(Q, φ)`, the residual the energy's
+/// gradient in `Q` and each sliding hole's edge `T_{k+1} − T_k e^{−μθ_k}` (values only), its
+/// matrix a central difference at the reference (a chord method).
+fn solve_sliding(
+    stick: &mut Stick<'_>,
+    q0: &[f64],
+    sliding: &[(usize, usize)],
+    dw: &Vector6<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    let (n, p) = (q0.len(), sliding.len());
+    let residual = |stick: &mut Stick<'_>, z: &[f64]| -> Vec<f64> {
+        stick.set_flux(sliding, &z[n..]);
+        let mut r = Potential::residual(stick, &z[..n], dw);
+        let state = stick.state(&z[..n]);
+        for &(c, k) in sliding {
+            let (t, theta) = &state[c];
+            r.push(t[k + 1] - t[k] * (-MU * theta[k]).exp());
+        }
+        r
+    };
+    let z0: Vec<f64> = q0.iter().copied().chain(std::iter::repeat_n(0.0, p)).collect();
+    let mut jac = Mat::<f64>::zeros(n + p, n + p);
+    for j in 0..n + p {
+        let h = if j < n { 1e-5 } else { 1e-8 };
+        let mut z = z0.clone();
+        z[j] += h;
+        let rp = residual(stick, &z);
+        z[j] -= 2.0 * h;
+        let rm = residual(stick, &z);
+        for i in 0..n + p {
+            jac[(i, j)] = (rp[i] - rm[i]) / (2.0 * h);
+        }
+    }
+    let lu = jac.partial_piv_lu();
+    let mut z = z0;
+    for _ in 0..60 {
+        let r = residual(stick, &z);
+        let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm < 1e-11 {
+            break;
+        }
+        let step = lu.solve(Mat::from_fn(n + p, 1, |i, _| -r[i]));
+        for (i, x) in z.iter_mut().enumerate() {
+            *x += step[(i, 0)];
+        }
+    }
+    stick.set_flux(sliding, &z[n..]);
+    (z[..n].to_vec(), z[n..].to_vec())
+}
+
+#[test]
+fn the_directional_compliance_is_the_nonlinear_models_with_its_holes_sliding() {
+    // Along the load (+y) and against it, after a pull: the nonlinear model, with the holes the
+    // library says slide free to pass cable at their edge and the others sticking, moves the
+    // tip by `ε (compliance) u` to first order in ε.
+    let u = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+    let q = cdhrm5::LOADED_POSE;
+    for pattern in cdhrm5::MODELS {
+        let s = setup(pattern, History::Pull);
+        let (m, r, f, t) = (&s.model, &s.routing, &s.friction, &s.actuator);
+        let both = directional_response(m, r, f, History::Pull, t, s.increment(), &u).unwrap();
+        let mut stick = Stick::new(&s.robot, &s.routing, &s.model, &q, &s.segments);
+        let mut values = Values::new(&s.robot, &s.routing);
+        for one in &both {
+            let sliding: Vec<(usize, usize)> =
+                one.sliding.iter().map(|e| (e.cable, e.hole)).collect();
+            let mut errors = Vec::new();
+            for eps in [1e-2, 1e-3] {
+                let (q_eps, phi) = solve_sliding(&mut stick, &q, &sliding, &(eps * one.direction));
+                let motion = values.motion(&q, &q_eps);
+                let compliance = one.direction.dot(&motion) / eps;
+                errors.push((compliance - one.compliance).abs() / one.compliance);
+                // The nonlinear solution is consistent: sliding holes pass cable toward the
+                // actuator, and the others stay inside their bands.
+                for (e, (f, f_lib)) in sliding.iter().zip(phi.iter().zip(&one.flux)) {
+                    assert!(*f < 0.0, "{pattern:?} {e:?}: flux {f:.2e}");
+                    assert!((f / eps - f_lib).abs() <= 0.05 * f_lib.abs(), "{pattern:?} {e:?}");
+                }
+                for b in stick.bands(&q_eps) {
+                    let slides = sliding.contains(&(b.0, b.1));
+                    assert!(slides || b.2 >= -1e-9 * b.4, "{pattern:?}: hole {b:?} pushed over");
+                }
+            }
+            println!(
+                "{pattern:?} {:?}: compliance {:.6e} ({} sliding); nonlinear at ε = 1e-2, 1e-3: relative error {:.1e}, {:.1e}",
+                one.direction.as_slice(),
+                one.compliance,
+                sliding.len(),
+                errors[0],
+                errors[1]
+            );
+            assert!(errors[1] <= 5e-5, "{pattern:?}: {errors:?}"); // measured ≤ 1.0e-5
+            assert!(
+                errors[1] <= 0.2 * errors[0] + 1e-6,
+                "{pattern:?}: not first order: {errors:?}"
+            );
         }
     }
 }
