@@ -370,45 +370,60 @@ impl ArmStatics {
         data.set.as_ref().ok_or(StaticsError::NoPose)
     }
 
-    /// Check that `tensions` are within their limits and balance `t0`.
+    /// [`check_balance`] on `J_c` and the cable limits.
     fn check_balance(
         &self,
         routing_data: &RoutingData,
         t0: &[f64],
         tensions: &[f64],
     ) -> Result<(), StaticsError> {
-        let m = self.cable_count();
-        if tensions.len() != m {
-            return Err(StaticsError::DimensionMismatch {
-                what: "tensions",
-                expected: m,
-                got: tensions.len(),
-            });
-        }
-        for (c, (&f, [lo, hi])) in tensions.iter().zip(&self.cable_limits).enumerate() {
-            if !(f.is_finite() && *lo <= f && f <= *hi) {
-                return Err(StaticsError::NotBalanced(NotBalanced::OutsideLimits {
-                    cable: self.cable_names[c].clone(),
-                    tension: f,
-                    limits: [*lo, *hi],
-                }));
-            }
-        }
         let jacobian = routing_data.jacobian()?;
-        let residual: Vec<f64> = (0..t0.len())
-            .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * tensions[c]).sum::<f64>())
-            .collect();
-        let scale = norm(t0).max(
-            (0..t0.len())
-                .map(|d| (0..m).map(|c| (jacobian[(c, d)] * tensions[c]).abs()).sum::<f64>())
-                .fold(0.0, f64::max),
-        );
-        if norm(&residual) > EQUILIBRIUM_TOLERANCE * scale {
-            return Err(StaticsError::NotBalanced(NotBalanced::Residual {
-                residual: norm(&residual),
-                t0: norm(t0),
+        check_balance(jacobian, t0, &self.cable_limits, &self.cable_names, tensions)
+    }
+}
+
+/// Whether the given `tensions` (m, N) are within `limits` (per cable) and balance the
+/// equilibrium torques `t0` through `jacobian` (m × dof: `J_c`, or a slip regime's `J̃_c` for
+/// actuator tensions): `|T0 + Jᵀ f| ≤` [`EQUILIBRIUM_TOLERANCE`] times the larger of `|T0|` and
+/// the largest `Σ_c |J_cd f_c|`. `names` name the cables.
+///
+/// # Errors
+/// [`StaticsError::DimensionMismatch`]; [`StaticsError::NotBalanced`] (outside a limit, naming
+/// the cable, or the residual).
+pub fn check_balance(
+    jacobian: faer::MatRef<'_, f64>,
+    t0: &[f64],
+    limits: &[[f64; 2]],
+    names: &[String],
+    tensions: &[f64],
+) -> Result<(), StaticsError> {
+    let m = limits.len();
+    if tensions.len() != m || jacobian.nrows() != m {
+        let got = if tensions.len() != m { tensions.len() } else { jacobian.nrows() };
+        return Err(StaticsError::DimensionMismatch { what: "tensions", expected: m, got });
+    }
+    for (c, (&f, [lo, hi])) in tensions.iter().zip(limits).enumerate() {
+        if !(f.is_finite() && *lo <= f && f <= *hi) {
+            return Err(StaticsError::NotBalanced(NotBalanced::OutsideLimits {
+                cable: names.get(c).cloned().unwrap_or_else(|| format!("cable {c}")),
+                tension: f,
+                limits: [*lo, *hi],
             }));
         }
-        Ok(())
     }
+    let residual: Vec<f64> = (0..t0.len())
+        .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * tensions[c]).sum::<f64>())
+        .collect();
+    let scale = norm(t0).max(
+        (0..t0.len())
+            .map(|d| (0..m).map(|c| (jacobian[(c, d)] * tensions[c]).abs()).sum::<f64>())
+            .fold(0.0, f64::max),
+    );
+    if norm(&residual) > EQUILIBRIUM_TOLERANCE * scale {
+        return Err(StaticsError::NotBalanced(NotBalanced::Residual {
+            residual: norm(&residual),
+            t0: norm(t0),
+        }));
+    }
+    Ok(())
 }

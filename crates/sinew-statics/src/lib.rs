@@ -71,7 +71,7 @@ mod set_block;
 mod slip;
 mod three_cable;
 
-pub use arm::{ArmStatics, ArmStaticsData};
+pub use arm::{ArmStatics, ArmStaticsData, check_balance};
 pub use choice::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
 pub use equilibrium::{EQUILIBRIUM_TOLERANCE, EquilibriumSet};

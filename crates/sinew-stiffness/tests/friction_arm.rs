@@ -1,0 +1,130 @@
+//! The pipeline with friction at the holes (`ArmStiffness::evaluate_with_friction`, spec §9,
+//! #27) on cdhrm5 at the loaded pose, both routings, μ = 0.1: the tensions of each regime
+//! balance the load through the regime's Jacobian, the dead band's ends reproduce the pull and
+//! release distributions, `K_q` is the regime's, `C_x` is `J_x (K_q + K_W)⁻¹ J_xᵀ` on it, and
+//! the levels, given tensions and μ = 0 are refused or checked as documented.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+use nalgebra::Vector6;
+use sinew_routing::{FrictionModel, Slip};
+use sinew_statics::{StaticsError, TensionChoice, TensionPolicy};
+use sinew_stiffness::{
+    ArmStiffness, ArmStiffnessData, EndOutcome, FrictionArmData, FrictionRegime, History,
+    StiffnessError,
+};
+use sinew_testkit::cdhrm5;
+
+const MU: f64 = 0.1;
+const F0: [f64; 6] = [0.0, 5.0, 0.0, 0.0, 0.0, 0.0];
+
+fn regimes() -> [FrictionRegime; 5] {
+    [
+        FrictionRegime::Slip(Slip::Pull),
+        FrictionRegime::Slip(Slip::Release),
+        FrictionRegime::Stick(History::Pull),
+        FrictionRegime::Stick(History::Release),
+        FrictionRegime::Stick(History::Equal),
+    ]
+}
+
+#[test]
+fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
+    let f0 = Vector6::from(F0);
+    let q = cdhrm5::LOADED_POSE;
+    for pattern in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(pattern);
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
+        let mut data = ArmStiffnessData::new(&arm);
+        let mut out = FrictionArmData::new(&arm, &model);
+        let n = arm.dof();
+        for regime in regimes() {
+            let choice = TensionChoice::Policy(TensionPolicy::Safest);
+            let outcome = arm
+                .evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, &f0, choice)
+                .unwrap();
+            assert_eq!(outcome, EndOutcome::Stiff, "{pattern:?} {regime:?}");
+            // Balance: −Σ_s T_s J_sᵀ = T0, from the segment tensions and the segment rows.
+            let t0 = &data.statics.t0;
+            let mut tau = vec![0.0; n];
+            for (c, segments) in out.segments.iter().enumerate() {
+                for (s, t) in segments.iter().enumerate().skip(1) {
+                    let j_s = out.friction.segment_jacobian(&model, c, s).unwrap();
+                    for (v, d) in j_s.values.iter().zip(j_s.dofs) {
+                        tau[d] -= t * v;
+                    }
+                }
+            }
+            let scale = t0.iter().map(|x| x.abs()).fold(0.0, f64::max);
+            let worst = tau.iter().zip(t0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(worst <= 1e-9 * scale, "{pattern:?} {regime:?}: residual {worst:.1e}");
+            // The dead band's ends are the pull and release distributions' actuator tensions.
+            for (c, band) in out.dead_band.iter().enumerate() {
+                let t = out.actuator[c];
+                assert!(band[0] <= t * (1.0 + 1e-12) && t <= band[1] * (1.0 + 1e-12));
+                let end = match regime {
+                    FrictionRegime::Slip(Slip::Pull) | FrictionRegime::Stick(History::Pull) => {
+                        band[1]
+                    }
+                    FrictionRegime::Slip(Slip::Release)
+                    | FrictionRegime::Stick(History::Release) => band[0],
+                    _ => continue,
+                };
+                assert!(
+                    (end - t).abs() <= 1e-12 * t,
+                    "{pattern:?} {regime:?} cable {c}: {end} vs {t}"
+                );
+            }
+            // C_x = J_x (K_q + K_W)⁻¹ J_xᵀ with the regime's K_q.
+            let k_q = out.stiffness.stiffness().unwrap().to_owned();
+            assert_eq!(out.stiffness.regime(), Some(regime));
+            let k_w = data.k_w().to_owned();
+            let j_x = data.j_x().to_owned();
+            let a = Mat::from_fn(n, n, |i, j| k_q[(i, j)] + k_w[(i, j)]);
+            let x = a.partial_piv_lu().solve(j_x.transpose().to_owned());
+            let c_x = &j_x * &x;
+            let got = out.end.compliance();
+            let scale = (0..6).map(|i| c_x[(i, i)].abs()).fold(0.0, f64::max);
+            for i in 0..6 {
+                for j in 0..6 {
+                    assert!(
+                        (got[(i, j)] - c_x[(i, j)]).abs() <= 1e-10 * scale,
+                        "{pattern:?} {regime:?}"
+                    );
+                }
+            }
+            assert!(out.margin > 0.0);
+        }
+        // Stick after equal takes the frictionless statics' tensions (any choice, levels too).
+        let levels = TensionChoice::Levels(&[0.5; 5]);
+        let equal = (&model, FrictionRegime::Stick(History::Equal));
+        arm.evaluate_with_friction(&mut data, &mut out, equal, &q, &f0, levels).unwrap();
+        assert_eq!(out.actuator, data.tensions());
+        // Levels need equal tensions; given actuator tensions are checked through J̃.
+        let pull = (&model, FrictionRegime::Slip(Slip::Pull));
+        let e = arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, levels).unwrap_err();
+        assert!(matches!(e, StiffnessError::LevelsWithFriction), "{e}");
+        arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, TensionChoice::Default)
+            .unwrap();
+        let chosen = out.actuator.clone();
+        let given = TensionChoice::Given(&chosen);
+        arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, given).unwrap();
+        assert_eq!(out.actuator, chosen);
+        let mut off = chosen.clone();
+        off[0] += 1.0;
+        let e = arm
+            .evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, TensionChoice::Given(&off))
+            .unwrap_err();
+        assert!(matches!(e, StiffnessError::Statics(StaticsError::NotBalanced(_))), "{e}");
+        // No band at μ = 0: the stick regime is refused.
+        let frictionless = FrictionModel::new(&routing);
+        let mut out0 = FrictionArmData::new(&arm, &frictionless);
+        let stick0 = (&frictionless, FrictionRegime::Stick(History::Equal));
+        let e = arm
+            .evaluate_with_friction(&mut data, &mut out0, stick0, &q, &f0, TensionChoice::Default)
+            .unwrap_err();
+        assert!(matches!(e, StiffnessError::StickWithoutFriction { cable: 0 }), "{e}");
+    }
+}
