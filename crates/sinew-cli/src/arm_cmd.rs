@@ -2,12 +2,13 @@
 
 use nalgebra::Vector6;
 use serde::Serialize;
-use sinew::statics::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
+use sinew::statics::{Chosen, DEFAULT_POLICY_NOTE};
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 
-use crate::cli::{ArmArgs, TensionArgs};
+use crate::arm_friction::{requested, run as run_with_friction};
+use crate::cli::ArmArgs;
 use crate::error::{CliError, library_error};
-use crate::input::{load, numbers_n, pose, wrench};
+use crate::input::{levels, load, pose, tension_choice, wrench};
 use crate::output::{
     Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, na_vec, print_json,
     q_labels,
@@ -88,26 +89,12 @@ struct EllipsoidOut {
     lambda_min: f64,
 }
 
-/// `--levels`, one per joint, if given. Levels outside [0, 1] are the library's to refuse
-/// (`--levels: joint i: …`).
-pub fn levels(args: &TensionArgs, joints: usize) -> Result<Option<Vec<f64>>, CliError> {
-    let what = format!("tension levels (one per joint, {joints} joints)");
-    args.levels.as_deref().map(|text| numbers_n("--levels", text, joints, &what)).transpose()
-}
-
-/// The tensions the options choose: `--levels` (as parsed by [`levels`]), `--policy`, or the
-/// default.
-pub fn tension_choice<'a>(levels: Option<&'a [f64]>, args: &TensionArgs) -> TensionChoice<'a> {
-    match (levels, args.policy) {
-        (Some(levels), _) => TensionChoice::Levels(levels),
-        (None, Some(policy)) => TensionChoice::Policy(policy.tension_policy()),
-        (None, None) => TensionChoice::Default,
-    }
-}
-
 /// Run `sinew arm`.
 pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
+    if let Some(friction) = requested(&args.friction, &loaded.routing)? {
+        return run_with_friction(args, &loaded, friction);
+    }
     let (robot, routing) = (&loaded.robot, &loaded.routing);
     let joints = robot.joint_count();
     let q = pose(&args.q, args.deg, robot)?;

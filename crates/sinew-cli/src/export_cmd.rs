@@ -8,9 +8,9 @@ use sinew::planner::{Planner, PlannerData};
 use sinew::stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_mjcf::{CableModel, MjcfOptions, Split, State};
 
-use crate::arm_cmd::{levels, tension_choice};
 use crate::cli::{CablesAs, MjcfArgs};
 use crate::error::{CliError, library_error};
+use crate::input::{levels, tension_choice};
 use crate::input::{load, one_number, pose, wrench};
 use crate::output::print_json;
 use crate::plan_cmd::{PlanRequest, request};

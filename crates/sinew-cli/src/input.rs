@@ -6,7 +6,9 @@ use nalgebra::Vector3;
 use sinew::robot::{DESCRIPTION_FILE, Robot, RobotDescription, RobotError};
 use sinew::routing::Routing;
 
-use crate::cli::Model;
+use sinew::statics::TensionChoice;
+
+use crate::cli::{Model, TensionArgs};
 use crate::error::{CliError, library_error};
 
 /// A robot folder, loaded: its description, the robot and the routing of the chosen model.
@@ -142,5 +144,22 @@ pub fn wrench(text: Option<&str>) -> Result<Vec<f64>, CliError> {
     match text {
         Some(text) => numbers_n("--wrench", text, 6, "wrench components (FX,FY,FZ,MX,MY,MZ)"),
         None => Ok(vec![0.0; 6]),
+    }
+}
+
+/// `--levels`, one per joint, if given. Levels outside [0, 1] are the library's to refuse
+/// (`--levels: joint i: …`).
+pub fn levels(args: &TensionArgs, joints: usize) -> Result<Option<Vec<f64>>, CliError> {
+    let what = format!("tension levels (one per joint, {joints} joints)");
+    args.levels.as_deref().map(|text| numbers_n("--levels", text, joints, &what)).transpose()
+}
+
+/// The tensions the options choose: `--levels` (as parsed by [`levels`]), `--policy`, or the
+/// default.
+pub fn tension_choice<'a>(levels: Option<&'a [f64]>, args: &TensionArgs) -> TensionChoice<'a> {
+    match (levels, args.policy) {
+        (Some(levels), _) => TensionChoice::Levels(levels),
+        (None, Some(policy)) => TensionChoice::Policy(policy.tension_policy()),
+        (None, None) => TensionChoice::Default,
     }
 }

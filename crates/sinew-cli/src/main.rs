@@ -13,6 +13,7 @@
 //! or 1 (the model has no answer, e.g. an infeasible load); never a panic.
 
 mod arm_cmd;
+mod arm_friction;
 mod cli;
 mod error;
 mod export_cmd;
