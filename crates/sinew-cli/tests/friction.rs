@@ -63,13 +63,25 @@ fn the_stick_and_slip_documents_are_the_librarys_numbers() {
         (FrictionRegime::Stick(History::Pull), vec!["--friction", "0.1"]),
         (FrictionRegime::Stick(History::Equal), vec!["--friction", "0.1", "--history", "equal"]),
         (FrictionRegime::Slip(Slip::Release), vec!["--friction", "0.1", "--regime", "release"]),
+        (FrictionRegime::Slip(Slip::Pull), vec!["--friction", "0.1", "--regime", "pull"]),
     ] {
-        let mut args = vec!["--json", "--policy", "safest"];
+        // The pull row takes the paper's levels (the closed form on J̃), the others a policy.
+        let by_levels = regime == FrictionRegime::Slip(Slip::Pull);
+        let mut args = vec!["--json"];
+        args.extend(if by_levels {
+            ["--levels", "0.5,0.5,0.5,0.5,0.5"]
+        } else {
+            ["--policy", "safest"]
+        });
         args.extend(&flags);
         let doc = json(&args);
         let mut data = ArmStiffnessData::new(&arm);
         let mut out = FrictionArmData::new(&arm, &model);
-        let choice = TensionChoice::Policy(TensionPolicy::Safest);
+        let choice = if by_levels {
+            TensionChoice::Levels(&[0.5; 5])
+        } else {
+            TensionChoice::Policy(TensionPolicy::Safest)
+        };
         arm.evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, &f0, choice).unwrap();
         assert_eq!(nums(&doc["tensions"]), out.actuator, "{flags:?}");
         let k_q = out.stiffness.stiffness().unwrap();
@@ -88,7 +100,8 @@ fn the_stick_and_slip_documents_are_the_librarys_numbers() {
         let FrictionRegime::Stick(history) = regime else {
             assert!(doc["directional"].is_null() && doc["stick_load_limit"].is_null());
             assert!(doc["k_q_skew_norm"].as_f64().unwrap() > 0.0);
-            assert_eq!(doc["friction"]["regime"], "release");
+            let name = if by_levels { "pull" } else { "release" };
+            assert_eq!(doc["friction"]["regime"], name);
             continue;
         };
         assert_eq!(doc["k_q_skew_norm"].as_f64().unwrap(), 0.0);
@@ -130,7 +143,7 @@ fn bad_input_is_one_line_and_exit_2() {
         (vec!["--friction", "0.1", "--regime", "pull", "--history", "equal"], "--history"),
         (vec!["--friction", "0.1", "--direction", "0,0,0"], "--direction"),
         (vec!["--friction", "0.1", "--direction", "1,0"], "--direction"),
-        (vec!["--friction", "0.1", "--levels", "0.5,0.5,0.5,0.5,0.5"], "tension levels"),
+        (vec!["--friction", "0.1", "--levels", "0.5,0.5,1.5,0.5,0.5"], "level"),
     ] {
         let out = run(&extra);
         let stderr = String::from_utf8_lossy(&out.stderr);

@@ -86,7 +86,7 @@ pub use joint_end::{
 pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
 pub use refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
 pub use set_block::SET_RANK_TOLERANCE;
-pub use slip::{actuator_limits, dead_band, slip_equilibrium_set, slip_torques};
+pub use slip::{actuator_limits, dead_band, slip_equilibrium_set, slip_levels, slip_torques};
 
 use faer::MatRef;
 

@@ -34,8 +34,14 @@ use std::ops::Range;
 
 use sinew_routing::{FrictionData, FrictionModel};
 
+use faer::Mat;
+use nalgebra::Vector3;
+
+use crate::distribution::{CableLayout, distribute_tensions};
 use crate::equilibrium::EquilibriumSet;
 use crate::error::StaticsError;
+use crate::interval::{TensionInterval, TensionLimits};
+use crate::refusal::InfeasibleReason;
 
 /// The joint torque of the slip regime whose weights `data` holds
 /// ([`sinew_routing::compute_capstan_weights`]): `τ = −Σ_c T_{c,0} J̃_cᵀ` (dof, N m) for the
@@ -140,6 +146,130 @@ pub fn slip_equilibrium_set(
     let mut limits = vec![[0.0; 2]; model.cable_count()];
     actuator_limits(model, data, segment_limits, &mut limits)?;
     EquilibriumSet::new(data.effective_jacobian()?, t0, &limits, groups)
+}
+
+/// The actuator tensions of the slip regime whose weights `data` holds at the tension levels
+/// `levels` (n, each in `[0, 1]`: 0 the least total tension on the joint's interval, 1 the
+/// most), into `out` (m = 3n, N): the levels of [`crate::distribute_tensions`] with `J̃` in
+/// place of `J_c` and each cable's actuator limits ([`actuator_limits`]) in place of the common
+/// ones. `t0` (2n) are the equilibrium torques. At μ = 0 the answer is the frictionless one to
+/// rounding. Allocates (a scaled copy of `J̃`).
+///
+/// # Math
+/// The cables' actuator intervals `[a_c, b_c]` differ, the closed form's limits are common.
+/// With `T_c = α_c g_c + β_c`, `α_c = (b_c − a_c)/(f_max − f_min)`, `β_c = a_c − α_c f_min`,
+/// `T_c ∈ [a_c, b_c] ⇔ g_c ∈ [f_min, f_max]`, and `t0 + J̃ᵀ T = 0 ⇔ t0' + (J̃ D)ᵀ g = 0` with
+/// `D = diag α`, `t0' = t0 + J̃ᵀ β`: the closed form on `(J̃ D, t0')` with the limits
+/// `[f_min, f_max]` gives `g`. An affine map keeps a segment's ends and its fractions, so
+/// level `s` of `g`'s interval is level `s` of `T`'s, up to the direction: the closed form
+/// orients a joint's null direction `n` by `Σ n ≥ 0`; where `Σ α n < 0` (no force closure) the
+/// level is mirrored, `1 − s`, so that level 0 stays the least total actuator tension.
+///
+/// # Errors
+/// Those of [`actuator_limits`] and [`crate::distribute_tensions`]; an
+/// [`StaticsError::Infeasible`] names the joint, the torque its own cables must hold and the
+/// widest of their actuator limits (a fixed tension is an actuator tension; the `λ` of
+/// [`crate::InfeasibleReason::OutsideLimits`] are those of the scaled problem).
+pub fn slip_levels(
+    model: &FrictionModel,
+    data: &FrictionData,
+    (layout, limits): (&CableLayout, TensionLimits),
+    segment_limits: &[[f64; 2]],
+    t0: &[f64],
+    levels: &[f64],
+    out: &mut [f64],
+) -> Result<(), StaticsError> {
+    let m = model.cable_count();
+    sizes(&[("actuator tensions", m, out.len())])?;
+    let mut actuator = vec![[0.0; 2]; m];
+    actuator_limits(model, data, segment_limits, &mut actuator)?;
+    let j_tilde = data.effective_jacobian()?;
+    let dof = j_tilde.ncols();
+    sizes(&[("equilibrium torques T0", dof, t0.len())])?;
+    let span = limits.f_max - limits.f_min;
+    let alpha: Vec<f64> = actuator.iter().map(|[a, b]| (b - a) / span).collect();
+    let beta: Vec<f64> =
+        actuator.iter().zip(&alpha).map(|([a, _], s)| a - s * limits.f_min).collect();
+    let scaled = Mat::from_fn(m, dof, |c, k| j_tilde[(c, k)] * alpha[c]);
+    let shifted: Vec<f64> = t0
+        .iter()
+        .enumerate()
+        .map(|(k, t)| t + (0..m).map(|c| j_tilde[(c, k)] * beta[c]).sum::<f64>())
+        .collect();
+    // Level 0 is the least total of `T`, not of `g`: where the joint's null direction in `g`
+    // (oriented to a non-negative sum, as the closed form does) has a negative sum once scaled
+    // by `α`, its interval runs the other way in `T`, and the level is mirrored.
+    let mut mirrored = Vec::with_capacity(levels.len());
+    for (i, &level) in levels.iter().enumerate() {
+        if !(0.0..=1.0).contains(&level) {
+            return Err(StaticsError::InvalidLevel { joint: i, level });
+        }
+        let rows = 3 * i..(3 * i + 3).min(m);
+        let column = |k: usize| {
+            let mut v = Vector3::zeros();
+            for (r, c) in rows.clone().enumerate() {
+                if 2 * i + k < dof {
+                    v[r] = scaled[(c, 2 * i + k)];
+                }
+            }
+            v
+        };
+        let mut null = column(0).cross(&column(1));
+        if null.sum() < 0.0 {
+            null = -null;
+        }
+        let in_t: f64 = rows.clone().enumerate().map(|(r, c)| alpha[c] * null[r]).sum();
+        mirrored.push(if in_t < 0.0 { 1.0 - level } else { level });
+    }
+    let mut intervals = vec![empty_interval(limits); layout.joints()];
+    let solved = distribute_tensions(
+        layout,
+        scaled.as_ref(),
+        limits,
+        &shifted,
+        &mirrored,
+        &mut intervals,
+        out,
+    );
+    if let Err(StaticsError::Infeasible { joint, torque, reason, .. }) = solved {
+        let own = 3 * joint..(3 * joint + 3).min(m);
+        let correction =
+            |k: usize| own.clone().map(|c| j_tilde[(c, 2 * joint + k)] * beta[c]).sum::<f64>();
+        let reason = match reason {
+            InfeasibleReason::FixedTension { cable, tension } => {
+                let c = 3 * joint + cable;
+                InfeasibleReason::FixedTension { cable, tension: alpha[c] * tension + beta[c] }
+            }
+            reason => reason,
+        };
+        let widest = own.clone().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], c| {
+            [lo.min(actuator[c][0]), hi.max(actuator[c][1])]
+        });
+        return Err(StaticsError::Infeasible {
+            joint,
+            torque: [torque[0] - correction(0), torque[1] - correction(1)],
+            limits: widest,
+            reason,
+        });
+    }
+    solved?;
+    for ((t, (a, b)), [lo, hi]) in out.iter_mut().zip(alpha.iter().zip(&beta)).zip(&actuator) {
+        *t = (a * *t + b).clamp(*lo, *hi);
+    }
+    Ok(())
+}
+
+/// A placeholder interval for [`slip_levels`]' scratch (overwritten by the closed form).
+fn empty_interval(limits: TensionLimits) -> TensionInterval {
+    TensionInterval {
+        joint: 0,
+        particular: Vector3::zeros(),
+        null: Vector3::zeros(),
+        lambda_min: 0.0,
+        lambda_max: 0.0,
+        limits,
+        limiting: [0, 0],
+    }
 }
 
 fn sizes(checks: &[(&'static str, usize, usize)]) -> Result<(), StaticsError> {

@@ -1,5 +1,6 @@
 //! The slip regimes' statics (spec §9, #27): the torque on `J̃`, the actuator-tension limits,
-//! the equilibrium set in the actuator tensions and the dead band; μ = 0 bit for bit.
+//! the equilibrium set in the actuator tensions, the paper's levels on them and the dead band;
+//! μ = 0 bit for bit.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use rand::Rng;
@@ -9,8 +10,9 @@ use sinew_routing::{
     compute_capstan_weights, compute_friction_geometry,
 };
 use sinew_statics::{
-    EquilibriumSet, StaticsError, TensionPolicy, actuator_limits, cable_torques, dead_band,
-    distribute_with_policy, slip_equilibrium_set, slip_torques,
+    CableLayout, EquilibriumSet, StaticsError, TensionInterval, TensionLimits, TensionPolicy,
+    actuator_limits, cable_torques, dead_band, distribute_tensions, distribute_with_policy,
+    slip_equilibrium_set, slip_levels, slip_torques,
 };
 use sinew_testkit::cdhrm5;
 use sinew_testkit::config::{random_qs, rng};
@@ -217,4 +219,213 @@ fn a_capstan_ratio_beyond_the_limits_is_a_typed_refusal() {
     assert_eq!(e.kind(), ErrorKind::Infeasible);
     let e = actuator_limits(&model, &friction, &tight[1..], &mut out).unwrap_err();
     assert!(matches!(e, StaticsError::DimensionMismatch { .. }));
+}
+
+// The paper's tension levels in the slip regimes ([`slip_levels`]): they balance the load
+// through `J̃`, keep each cable within its own actuator limits, put level 0 and 1 on them, agree
+// with the least-total policy where the joints are independent, are the frictionless closed form
+// at μ = 0, and name a joint's true torque when they refuse.
+
+/// The friction data at `q` with `slip`'s weights, and the routing's common limits.
+fn weights(
+    robot: &Robot,
+    routing: &Routing,
+    model: &FrictionModel,
+    q: &[f64],
+    slip: Slip,
+) -> (RoutingData, FrictionData, TensionLimits) {
+    let (geometry, mut friction) = evaluate(robot, routing, model, q);
+    compute_capstan_weights(model, &mut friction, slip).unwrap();
+    let [f_min, f_max] = routing.cable_limits()[0];
+    (geometry, friction, TensionLimits { f_min, f_max })
+}
+
+/// A load the cables hold: the torque of actuator tensions in the middle of their limits.
+fn load(friction: &FrictionData, limits: &[[f64; 2]], seed: u64) -> Vec<f64> {
+    let mut r = rng(seed);
+    let t: Vec<f64> = limits
+        .iter()
+        .map(|l| r.random_range(l[0] + 0.3 * (l[1] - l[0])..l[0] + 0.6 * (l[1] - l[0])))
+        .collect();
+    let mut t0 = vec![0.0; friction.effective_jacobian().unwrap().ncols()];
+    slip_torques(friction, &t, &mut t0).unwrap();
+    t0
+}
+
+#[test]
+fn the_levels_balance_the_load_within_each_cables_actuator_limits() {
+    for (case, robot, routing) in cases() {
+        let layout = CableLayout::new(&routing).unwrap();
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+        let (m, joints) = (routing.cable_count(), layout.joints());
+        let names: Vec<String> = routing.cables().iter().map(|c| c.name.clone()).collect();
+        let mut answered = 0;
+        for (k, q) in random_qs(&robot, 32, 2).iter().enumerate() {
+            for slip in [Slip::Pull, Slip::Release] {
+                let (_, friction, common) = weights(&robot, &routing, &model, q, slip);
+                let cable_limits = routing.cable_limits();
+                let mut limits = vec![[0.0; 2]; m];
+                actuator_limits(&model, &friction, cable_limits, &mut limits).unwrap();
+                let t0 = load(&friction, &limits, 33 + k as u64);
+                // In the routed model the closed form fixes the distal joints first, and their
+                // levels may overload a proximal joint (the frictionless levels refuse so too):
+                // such a refusal is a result there, never in the decoupled model.
+                let at = |levels: &[f64]| {
+                    let mut t = vec![0.0; m];
+                    let closed_form = (&layout, common);
+                    match slip_levels(
+                        &model,
+                        &friction,
+                        closed_form,
+                        cable_limits,
+                        &t0,
+                        levels,
+                        &mut t,
+                    ) {
+                        Ok(()) => Some(t),
+                        Err(StaticsError::Infeasible { .. }) if !routing.is_decoupled() => None,
+                        Err(e) => panic!("{case} {slip:?} {levels:?}: {e}"),
+                    }
+                };
+                let mut r = rng(34 + k as u64);
+                let random: Vec<f64> = (0..joints).map(|_| r.random_range(0.0..1.0)).collect();
+                let (low, high) = (at(&vec![0.0; joints]), at(&vec![1.0; joints]));
+                let answers = [low.clone(), at(&vec![0.5; joints]), high.clone(), at(&random)];
+                for t in answers.iter().flatten() {
+                    answered += 1;
+                    let mut tau = vec![0.0; t0.len()];
+                    slip_torques(&friction, t, &mut tau).unwrap();
+                    let scale = t0.iter().fold(1.0_f64, |s, x| s.max(x.abs()));
+                    for (a, b) in tau.iter().zip(&t0) {
+                        assert!((a - b).abs() <= 1e-10 * scale, "{case} {slip:?}: {a} vs {b}");
+                    }
+                    for (c, (t, l)) in t.iter().zip(&limits).enumerate() {
+                        assert!(l[0] <= *t && *t <= l[1], "{case} {slip:?}: cable {c}: {t} {l:?}");
+                    }
+                }
+                // Level 0 and level 1 are the ends of each joint's interval: some cable on one of
+                // its own actuator limits (in force closure, level 0 on a least tension and
+                // level 1 on a greatest; without it, a cable may meet the other limit).
+                for i in 0..joints {
+                    let own = 3 * i..3 * i + 3;
+                    let gap = |t: &[f64]| {
+                        own.clone()
+                            .flat_map(|c| limits[c].map(|l| (t[c] - l).abs() / l))
+                            .fold(f64::INFINITY, f64::min)
+                    };
+                    for (level, t) in [(0, &low), (1, &high)] {
+                        if let Some(t) = t {
+                            assert!(gap(t) <= 1e-12, "{case} {slip:?}: joint {i} at level {level}");
+                        }
+                    }
+                }
+                // Where the joints are independent, level 0 is the least total tension and
+                // level ½ the middle of the two ends.
+                if routing.is_decoupled() {
+                    let set = slip_equilibrium_set(
+                        &model,
+                        &friction,
+                        &t0,
+                        cable_limits,
+                        routing.joint_groups(),
+                    )
+                    .unwrap();
+                    let mut least = vec![0.0; m];
+                    let groups = routing.joint_groups();
+                    let policy = TensionPolicy::LeastTotal;
+                    distribute_with_policy(&set, policy, groups, &names, &mut least).unwrap();
+                    let half = at(&vec![0.5; joints]).unwrap();
+                    let (low, high) = (low.unwrap(), high.unwrap());
+                    for c in 0..m {
+                        let scale = limits[c][1];
+                        assert!((least[c] - low[c]).abs() <= 1e-8 * scale, "{case}: cable {c}");
+                        let mid = 0.5 * (low[c] + high[c]);
+                        assert!((half[c] - mid).abs() <= 1e-10 * scale, "{case}: cable {c}");
+                    }
+                }
+            }
+        }
+        // Two poses × two slips × four level sets; the routed refusals are a minority.
+        assert!(answered >= 12, "{case}: {answered} of 16 answered");
+    }
+}
+
+#[test]
+fn at_mu_zero_the_levels_are_the_frictionless_closed_form() {
+    for (case, robot, routing) in cases() {
+        let layout = CableLayout::new(&routing).unwrap();
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.0).unwrap();
+        let (m, joints) = (routing.cable_count(), layout.joints());
+        let q = &random_qs(&robot, 35, 1)[0];
+        let (geometry, friction, common) = weights(&robot, &routing, &model, q, Slip::Pull);
+        let t0 = load(&friction, routing.cable_limits(), 36);
+        let levels: Vec<f64> = (0..joints).map(|i| (i as f64 + 0.5) / joints as f64).collect();
+        let mut slip = vec![0.0; m];
+        let closed_form = (&layout, common);
+        let cable_limits = routing.cable_limits();
+        slip_levels(&model, &friction, closed_form, cable_limits, &t0, &levels, &mut slip).unwrap();
+        let mut intervals = vec![placeholder(common); joints];
+        let mut today = vec![0.0; m];
+        let jacobian = geometry.jacobian().unwrap();
+        distribute_tensions(&layout, jacobian, common, &t0, &levels, &mut intervals, &mut today)
+            .unwrap();
+        for (c, (a, b)) in slip.iter().zip(&today).enumerate() {
+            assert!((a - b).abs() <= 1e-12 * b, "{case}: cable {c}: {a} vs {b}");
+        }
+    }
+}
+
+#[test]
+fn a_load_beyond_the_limits_names_the_joint_and_its_true_torque() {
+    for (case, robot, routing) in cases().into_iter().filter(|(_, _, r)| r.is_decoupled()) {
+        let layout = CableLayout::new(&routing).unwrap();
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+        let (m, joints) = (routing.cable_count(), layout.joints());
+        let q = &random_qs(&robot, 37, 1)[0];
+        let (_, friction, common) = weights(&robot, &routing, &model, q, Slip::Release);
+        let mut limits = vec![[0.0; 2]; m];
+        actuator_limits(&model, &friction, routing.cable_limits(), &mut limits).unwrap();
+        let mut t0 = load(&friction, &limits, 38);
+        // The last joint overloaded: the joints before it are solved and hold.
+        let last = joints - 1;
+        t0[2 * last] *= 1e3;
+        t0[2 * last + 1] *= 1e3;
+        let mut t = vec![0.0; m];
+        let closed_form = (&layout, common);
+        let levels = vec![0.5; joints];
+        let e = slip_levels(
+            &model,
+            &friction,
+            closed_form,
+            routing.cable_limits(),
+            &t0,
+            &levels,
+            &mut t,
+        )
+        .unwrap_err();
+        let StaticsError::Infeasible { joint, torque, limits: reported, .. } = e else {
+            panic!("{case}: {e}")
+        };
+        assert_eq!(joint, last, "{case}");
+        for k in 0..2 {
+            let want = t0[2 * last + k];
+            assert!((torque[k] - want).abs() <= 1e-9 * want.abs(), "{case}: {torque:?}");
+        }
+        let own = &limits[3 * last..3 * last + 3];
+        let lo = own.iter().map(|l| l[0]).fold(f64::INFINITY, f64::min);
+        let hi = own.iter().map(|l| l[1]).fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(reported, [lo, hi], "{case}");
+    }
+}
+
+fn placeholder(limits: TensionLimits) -> TensionInterval {
+    TensionInterval {
+        joint: 0,
+        particular: Default::default(),
+        null: Default::default(),
+        lambda_min: 0.0,
+        lambda_max: 0.0,
+        limits,
+        limiting: [0, 0],
+    }
 }

@@ -73,12 +73,6 @@ pub enum StiffnessError {
         /// Smallest eigenvalue of the symmetric part of that joint stiffness.
         min_eigenvalue: f64,
     },
-    /// The paper's tension levels asked for in a friction regime with a pull or release
-    /// distribution: the levels are the closed form of equal tensions along each cable.
-    #[error(
-        "tension levels need equal tensions along each cable: with friction after a pull or release, choose a policy or give the actuator tensions"
-    )]
-    LevelsWithFriction,
     /// A stage of the pipeline asked for before the stage it needs: tensions before a pose
     /// ([`crate::ArmStiffness::set_pose`]), the end before tensions
     /// ([`crate::ArmStiffness::set_tensions`]).
@@ -166,7 +160,6 @@ impl StiffnessError {
             | StiffnessError::InvalidWrenchDirection { .. }
             | StiffnessError::StageMissing { .. }
             | StiffnessError::StickWithoutFriction { .. }
-            | StiffnessError::LevelsWithFriction
             | StiffnessError::WrongCapstanWeights { .. } => ErrorKind::Input,
             StiffnessError::Statics(e) => e.kind(),
             StiffnessError::Robot(e) => e.kind(),

@@ -10,9 +10,9 @@
 //!   `T_0 w_s`, so the actuator tensions `T_0` balance the load through `J̃`
 //!   (`sinew_statics::slip_equilibrium_set`, with the actuator limits that keep every segment
 //!   within the cable's limits): a policy over that set ([`TensionChoice::Default`]: least
-//!   total), or given actuator tensions checked against it. The paper's tension levels are the
-//!   closed form of equal tensions and are refused here
-//!   ([`StiffnessError::LevelsWithFriction`]).
+//!   total), the paper's tension levels on each joint's interval of actuator tensions
+//!   (`sinew_statics::slip_levels`: the closed form on `J̃` with each cable's actuator limits),
+//!   or given actuator tensions checked against it.
 //!
 //! The end stage is the dense one ([`crate::end_stiffness`]): a slip `K` is not symmetric, and
 //! a routed stick `K` is not block structured.
@@ -23,7 +23,7 @@ use sinew_routing::{
 };
 use sinew_statics::{
     TensionChoice, TensionPolicy, actuator_limits, check_balance, dead_band,
-    distribute_with_policy, slip_equilibrium_set,
+    distribute_with_policy, slip_equilibrium_set, slip_levels,
 };
 
 use crate::arm::ArmStiffness;
@@ -82,8 +82,7 @@ impl ArmStiffness {
     /// the frictionless tension stage). Unstable and rank-deficient are outcomes.
     ///
     /// # Errors
-    /// Those of the pose stage, the statics ([`StiffnessError::LevelsWithFriction`] for levels
-    /// in a regime with a pull or release distribution), [`crate::stick_stiffness`] (μ = 0 in
+    /// Those of the pose stage, the statics, [`crate::stick_stiffness`] (μ = 0 in
     /// the stick regime) and [`crate::slip_stiffness`]; numerical failures of the end stage.
     pub fn evaluate_with_friction(
         &self,
@@ -180,7 +179,13 @@ impl ArmStiffness {
         let statics = self.statics();
         let names: Vec<String> = self.routing().cables().iter().map(|c| c.name.clone()).collect();
         let policy = match choice {
-            TensionChoice::Levels(_) => return Err(StiffnessError::LevelsWithFriction),
+            TensionChoice::Levels(levels) => {
+                let closed_form = (statics.closed_form()?, statics.limits());
+                let (t0, limits) = (&data.statics.t0, statics.cable_limits());
+                let out_t = &mut out.actuator;
+                slip_levels(model, &out.friction, closed_form, limits, t0, levels, out_t)?;
+                return Ok(());
+            }
             TensionChoice::Given(tensions) => {
                 let mut limits = vec![[0.0; 2]; model.cable_count()];
                 actuator_limits(model, &out.friction, statics.cable_limits(), &mut limits)?;

@@ -2,7 +2,8 @@
 //! #27) on cdhrm5 at the loaded pose, both routings, μ = 0.1: the tensions of each regime
 //! balance the load through the regime's Jacobian, the dead band's ends reproduce the pull and
 //! release distributions, `K_q` is the regime's, `C_x` is `J_x (K_q + K_W)⁻¹ J_xᵀ` on it, and
-//! the levels, given tensions and μ = 0 are refused or checked as documented.
+//! the levels, given tensions and μ = 0 are refused or checked as documented; a sliding set that
+//! is itself unstable, and one that makes the increment singular, are typed refusals.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
@@ -11,8 +12,8 @@ use nalgebra::Vector6;
 use sinew_routing::{FrictionModel, Slip};
 use sinew_statics::{StaticsError, TensionChoice, TensionPolicy};
 use sinew_stiffness::{
-    ArmStiffness, ArmStiffnessData, EndOutcome, FrictionArmData, FrictionRegime, History,
-    StiffnessError,
+    ArmStiffness, ArmStiffnessData, BandEdge, EndOutcome, FrictionArmData, FrictionRegime, History,
+    HoleEvent, StiffnessError, directional_response, sliding_response,
 };
 use sinew_testkit::cdhrm5;
 
@@ -102,10 +103,22 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
         let equal = (&model, FrictionRegime::Stick(History::Equal));
         arm.evaluate_with_friction(&mut data, &mut out, equal, &q, &f0, levels).unwrap();
         assert_eq!(out.actuator, data.tensions());
-        // Levels need equal tensions; given actuator tensions are checked through J̃.
+        // Levels under pull are the closed form on J̃ with the actuator limits: in the
+        // decoupled model level 0 is the least total (the default policy); given actuator
+        // tensions are checked through J̃.
         let pull = (&model, FrictionRegime::Slip(Slip::Pull));
-        let e = arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, levels).unwrap_err();
-        assert!(matches!(e, StiffnessError::LevelsWithFriction), "{e}");
+        let lowest = TensionChoice::Levels(&[0.0; 5]);
+        arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, lowest).unwrap();
+        let at_level_0 = out.actuator.clone();
+        arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, TensionChoice::Default)
+            .unwrap();
+        if routing.is_decoupled() {
+            for (a, b) in at_level_0.iter().zip(&out.actuator) {
+                assert!((a - b).abs() <= 1e-8 * b, "{pattern:?}: {a} vs {b}");
+            }
+        }
+        arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, levels).unwrap();
+        assert!(out.margin.is_finite());
         arm.evaluate_with_friction(&mut data, &mut out, pull, &q, &f0, TensionChoice::Default)
             .unwrap();
         let chosen = out.actuator.clone();
@@ -127,4 +140,58 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
             .unwrap_err();
         assert!(matches!(e, StiffnessError::StickWithoutFriction { cable: 0 }), "{e}");
     }
+}
+
+/// Sticking holes hold an arm the frictionless model finds unstable (E4's load at the lowest
+/// levels); after a pull a load increment makes some of them slide, and on cdhrm5 the arm they
+/// leave is still stable. A destabilising load stiffness `−c I` added to `K_W` (measured on
+/// this arm: answers up to `c ≈ 0.1 λ`, λ the stick arm's least eigenvalue; no consistent set
+/// of sliding holes from `0.375 λ` to `2.15 λ`, where some sliding sets leave an indefinite
+/// arm; beyond, a consistent set whose arm is unstable) turns each answer into its typed
+/// refusal. The same hole named twice makes the increment's system singular.
+#[test]
+fn an_unstable_or_singular_sliding_set_is_refused() {
+    let f0 = Vector6::from(F0);
+    let q = cdhrm5::LOADED_POSE;
+    let (robot, routing) = cdhrm5::robot_and_routing(sinew_routing::PatternModel::Decoupled);
+    let arm = ArmStiffness::new(&robot, &routing).unwrap();
+    let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
+    let mut data = ArmStiffnessData::new(&arm);
+    let mut out = FrictionArmData::new(&arm, &model);
+    let lowest = TensionChoice::Levels(&[0.0; 5]);
+    arm.evaluate_joints(&mut data, &q, &f0, lowest).unwrap();
+    let outcome = arm.solve_end(&mut data).unwrap();
+    assert!(matches!(outcome, EndOutcome::Unstable { .. }), "{outcome:?}");
+    let after_pull = (&model, FrictionRegime::Stick(History::Pull));
+    let outcome =
+        arm.evaluate_with_friction(&mut data, &mut out, after_pull, &q, &f0, lowest).unwrap();
+    assert_eq!(outcome, EndOutcome::Stiff, "sticking holes hold the arm");
+    let k_q = out.stiffness.stiffness().unwrap().to_owned();
+    let (k_w, j_x) = (data.k_w().to_owned(), data.j_x().to_owned());
+    let n = k_q.nrows();
+    let u = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+    let (f, t) = (&out.friction, &out.actuator);
+    let stick = Mat::from_fn(n, n, |i, j| 0.5 * (k_q[(i, j)] + k_q[(j, i)]) + k_w[(i, j)]);
+    let least = stick.self_adjoint_eigenvalues(faer::Side::Lower).unwrap()[0];
+    assert!(least > 0.0);
+    let respond = |c: f64| {
+        let softer = Mat::from_fn(n, n, |i, j| k_w[(i, j)] - if i == j { c } else { 0.0 });
+        let increment = (k_q.as_ref(), softer.as_ref(), j_x.as_ref());
+        directional_response(&model, &routing, f, History::Pull, t, increment, &u).map_err(Box::new)
+    };
+    let [plus, minus] = respond(0.0).unwrap();
+    assert!(plus.stiffness > 0.0 && minus.stiffness > 0.0 && plus.stiffness != minus.stiffness);
+    let e = *respond(least).unwrap_err();
+    assert!(matches!(e, StiffnessError::NoConsistentSliding { passes } if passes > 0), "{e}");
+    let e = *respond(3.0 * least).unwrap_err();
+    let StiffnessError::UnstableSliding { holes, min_eigenvalue } = e else { panic!("{e}") };
+    assert!(holes > 0 && min_eigenvalue < 0.0, "{e}");
+    assert_eq!(e.kind(), sinew_robot::ErrorKind::Unstable);
+    // One hole named twice: two equal columns.
+    let increment = (k_q.as_ref(), k_w.as_ref(), j_x.as_ref());
+    let event = HoleEvent { cable: 0, hole: 0, edge: BandEdge::Lower, kinked: false };
+    let twice = [event, event];
+    let e =
+        sliding_response(&model, &routing, f, History::Pull, t, increment, &u, &twice).unwrap_err();
+    assert!(matches!(e, StiffnessError::NoConsistentSliding { .. }), "{e}");
 }
