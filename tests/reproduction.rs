@@ -279,3 +279,14 @@ fn e7_tension_stiffens() {
         }
     }
 }
+
+/// E6 (beyond the paper, #27): friction at the holes. The tables as a snapshot; what their
+/// numbers must satisfy is `tests/e6_friction.rs`.
+#[test]
+fn e6_friction() {
+    let r = report();
+    let rendered = paper::render_e6(&r.e6);
+    insta::assert_snapshot!("e6_friction", rendered);
+    assert_committed(paper::E6_FILE, &rendered);
+    assert!(r.readme().contains(&rendered), "the README shows E6's tables");
+}

@@ -83,3 +83,11 @@ pub const E7_MIN_GAP: f64 = 0.005;
 /// The off-centre geometry of one of CASPR's snake models (issue #27, spec §10): holes 6.6 mm
 /// below and 13.6 mm above the joint centre, `[d1, d2]`, m.
 pub const E7_OFF_CENTRE: [f64; 2] = [0.0066, 0.0136];
+
+/// E6's friction coefficients at every hole: 0 (the paper's model), then 0.05 (a steel or
+/// polymer cable through PTFE-lined holes: PTFE's sliding friction on steel is among the lowest
+/// of engineering materials, about 0.05–0.1 in handbook tables), 0.1 and 0.2 (a steel cable on
+/// bare aluminium discs, lubricated; dry metal pairs run higher).
+pub const E6_MU: [f64; 4] = [0.0, 0.05, 0.1, 0.2];
+/// E6's tension level for equal tensions along each cable (every joint).
+pub const E6_LEVEL: f64 = 0.5;

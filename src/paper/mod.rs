@@ -12,6 +12,7 @@
 mod arm;
 mod claim;
 mod claims;
+mod e6;
 mod e7;
 mod experiments;
 mod patterns;
@@ -27,11 +28,15 @@ pub use arm::{
 };
 pub use claim::Claim;
 pub use claims::{claims_e1_e3, render_claims};
+pub use e6::{
+    E6, E6_FILE, E6_REGIMES, E6Row, FIG_E6_FILE, e6, e6_section, regime_label, render_e6,
+};
 pub use e7::{E7, E7Case, E7Cell, E7Map, e7, render_e7};
 pub use experiments::{
     E2_Q, E2_SAMPLES, E2_TORQUE, E3_POINTS, E3_RANGE, E3_TORQUE, E4_CASES, E4_F0,
-    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, E7_MIN_GAP,
-    E7_OFF_CENTRE, E7_POINTS, E7_POSES, E7_RANGE_MM, PAPER_TABLE_2, SINGLE_JOINT, TABLE_2_TORQUE,
+    E4_PAPER_BASELINE, E4_Q, E4_STABLE_BASELINE, E5_MARGIN, E5_TRADEOFF_POINTS, E6_LEVEL, E6_MU,
+    E7_MIN_GAP, E7_OFF_CENTRE, E7_POINTS, E7_POSES, E7_RANGE_MM, PAPER_TABLE_2, SINGLE_JOINT,
+    TABLE_2_TORQUE,
 };
 pub use patterns::{
     LEAST_RANGE_AWAY, MAX_RISE, MAX_RISE_OVER_MIN_MOVE, NEAR_ZERO_MAX, NEAR_ZERO_SHARE,

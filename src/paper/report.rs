@@ -12,6 +12,7 @@ use crate::routing::Routing;
 
 use super::arm::{E4, claims_e4_end, claims_e4_joints, e4, render_e4, render_routed_vs_decoupled};
 use super::claims::{Claim, claims_e1_e3, render_claims};
+use super::e6::{E6, E6_FILE, e6, e6_section, render_e6};
 use super::e7::{E7, e7, render_e7};
 use super::experiments::{E2_SAMPLES, E3_POINTS, E4_PAPER_BASELINE, E4_STABLE_BASELINE, E5_MARGIN};
 use super::planning::{E5, e5, e5_csv, render_e5};
@@ -104,6 +105,8 @@ pub struct Report {
     pub e5_decoupled: E5,
     /// E5, the routed model.
     pub e5_routed: E5,
+    /// E6 (beyond the paper): friction at the holes, decoupled and routed.
+    pub e6: E6,
     /// E7 (beyond the paper): when tension stiffens, on joint 1's hole geometry.
     pub e7: E7,
 }
@@ -154,6 +157,7 @@ impl Report {
             .collect();
         let e5_decoupled = e5(&robot, &routing, "decoupled")?;
         let e5_routed = e5(&robot, &routed, "routed")?;
+        let e6 = e6(&robot, [("decoupled", &routing), ("routed", &routed)])?;
         let routing_file = robot_dir.join(crate::routing::ROUTING_FILE);
         let text = std::fs::read_to_string(&routing_file).map_err(|source| {
             crate::routing::RoutingError::Io { path: routing_file.clone(), source }
@@ -176,6 +180,7 @@ impl Report {
             claims_e4,
             e5_decoupled,
             e5_routed,
+            e6,
             e7,
         })
     }
@@ -206,6 +211,7 @@ impl Report {
         files.push(("e5_decoupled.md", render_e5(&self.e5_decoupled)));
         files.push(("e5_routed.md", render_e5(&self.e5_routed)));
         files.push(("e5_tradeoff.csv", e5_csv(&[&self.e5_decoupled, &self.e5_routed])));
+        files.push((E6_FILE, render_e6(&self.e6)));
         files.push((E7_FILE, render_e7(&self.e7)));
         files.push(("README.md", self.readme()));
         files
@@ -289,6 +295,7 @@ impl Report {
             r,
             "The best λ_min(K_fd) against the tension budget (data: `e5_tradeoff.csv`):\n\n![E5 trade-off]({FIG_E5_FILE})\n"
         )?;
+        writeln!(r, "{}", e6_section(&self.e6))?;
         self.write_e7(r)
     }
 

@@ -1,10 +1,11 @@
-//! The line plots: Fig. 4 (E2) and E5's trade-off, SVG.
+//! The line plots: Fig. 4 (E2), E5's trade-off and E6's λ_min against μ, SVG.
 
 use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use sinew::paper::{E2Point, E5};
+use sinew::paper::{E2Point, E5, E6, E6_REGIMES, regime_label};
+use sinew::stiffness::FrictionRegime;
 
 use super::axes::Axes;
 use super::layout::{Layout, Rect, Target, register_font};
@@ -150,4 +151,75 @@ pub fn fig_e5(runs: &[&E5], path: &Path) -> DynResult<Layout> {
     panel(&root, Rect::sized(0, 0, 700, 450), &axes, &series, &mut layout)?;
     root.present()?;
     layout.check("the E5 trade-off figure")
+}
+
+/// E6: `λ_min(K_fd)` against μ, one line per model and regime, the slip regimes (from the
+/// frictionless arm at μ = 0) and the stick regimes in two panels (two orders of magnitude
+/// apart). Returns where its parts went, checked ([`Layout::check`]).
+pub fn fig_e6(e6: &E6, path: &Path) -> DynResult<Layout> {
+    register_font()?;
+    let size = (1100, 450);
+    let mut layout = Layout::new(Target::Svg, size);
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let models = ["decoupled", "routed"];
+    let colours = [
+        [RGBColor(200, 30, 30), RGBColor(240, 130, 40), RGBColor(150, 0, 110)],
+        [RGBColor(30, 60, 200), RGBColor(0, 160, 170), RGBColor(20, 130, 40)],
+    ];
+    let line = |model: &str, regime: FrictionRegime, colour: RGBColor| {
+        let mut points: Vec<(f64, f64)> = e6
+            .rows
+            .iter()
+            .filter(|r| r.model == model && r.regime == Some(regime))
+            .filter_map(|r| r.lambda_min.map(|k| (r.mu, k)))
+            .collect();
+        if matches!(regime, FrictionRegime::Slip(_)) {
+            let start = e6.rows.iter().find(|r| r.model == model && r.regime.is_none());
+            if let Some(k) = start.and_then(|r| r.lambda_min) {
+                points.insert(0, (0.0, k));
+            }
+        }
+        Series {
+            label: format!("{model}, {}", regime_label(Some(regime))),
+            colour,
+            points,
+            dots: true,
+        }
+    };
+    let (slip, stick): (Vec<FrictionRegime>, Vec<FrictionRegime>) =
+        E6_REGIMES.iter().partition(|r| matches!(r, FrictionRegime::Slip(_)));
+    let series = |regimes: &[FrictionRegime]| -> Vec<Series> {
+        models
+            .iter()
+            .zip(&colours)
+            .flat_map(|(model, colours)| {
+                regimes
+                    .iter()
+                    .zip(colours)
+                    .map(move |(&regime, &colour)| line(model, regime, colour))
+            })
+            .collect()
+    };
+    let mu_max = e6.rows.iter().map(|r| r.mu).fold(0.0, f64::max);
+    let panels = [
+        ("(a) slip: every hole sliding one way", series(&slip), Rect::sized(0, 0, 550, 450)),
+        ("(b) stick: no hole sliding", series(&stick), Rect::sized(550, 0, 550, 450)),
+    ];
+    for (title, series, area) in panels {
+        let (_, top) = span(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).chain([0.0]));
+        let axes = Axes {
+            title: Some(title),
+            x_desc: "friction coefficient μ at every hole",
+            y_desc: "λ_min(K_fd) (N/m)",
+            x: (0.0, mu_max),
+            y: (0.0, top * 1.6),
+            ticks: (5, 8),
+            grid: true,
+            size: 13.0,
+        };
+        panel(&root, area, &axes, &series, &mut layout)?;
+    }
+    root.present()?;
+    layout.check("the E6 figure")
 }

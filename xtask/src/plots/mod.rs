@@ -1,6 +1,6 @@
 //! The report's figures, all drawn with plotters and the embedded DejaVu Sans
 //! (`xtask/assets/`, through plotters' `ab_glyph` feature: no system font): the line plots
-//! (Fig. 4, E5) and the ellipses (Fig. 6) as SVG, the heat maps of Fig. 5 and E7's map as PNG.
+//! (Fig. 4, E5, E6) and the ellipses (Fig. 6) as SVG, the heat maps of Fig. 5 and E7's map as PNG.
 //!
 //! Every text is placed from the font's metrics and every legend where no curve is; each figure
 //! returns its [`layout::Layout`] and fails rather than be written with a text outside its canvas or
@@ -21,7 +21,7 @@ mod sign_map;
 
 pub use ellipses::fig6;
 pub use heat::heat_map;
-pub use lines::{fig_e5, fig4};
+pub use lines::{fig_e5, fig_e6, fig4};
 pub use sign_map::fig_e7;
 
 #[cfg(test)]
@@ -54,6 +54,8 @@ mod tests {
             ];
             let e7 = fig_e7(&report.e7, &path(paper::FIG_E7_FILE)).unwrap();
             out.push((paper::FIG_E7_FILE.to_owned(), e7));
+            let e6 = fig_e6(&report.e6, &path(paper::FIG_E6_FILE)).unwrap();
+            out.push((paper::FIG_E6_FILE.to_owned(), e6));
             for map in paper::FIG5_MAPS {
                 let layout = heat_map(&report.e3, map.title, map.value, &path(map.file)).unwrap();
                 out.push((map.file.to_owned(), layout));
