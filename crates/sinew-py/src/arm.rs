@@ -18,6 +18,7 @@ use crate::batch::BatchChoice;
 use crate::batch_out::evaluate_to_numpy;
 use crate::convert::{matrix, na2, vec1, vector, wrenches};
 use crate::errors::{input, library};
+use crate::friction::{FrictionArgs, evaluate_friction, requested};
 use crate::lazy::LazyArray;
 use crate::model::{Robot, Routing};
 use crate::plan_along::along_result;
@@ -128,7 +129,15 @@ impl ArmStiffness {
     /// `sinew arm` reports it; with `require_stiffness=True` it raises `UnstableError`, and a
     /// rank-deficient `J_x` (`k_x` None) raises `RankDeficientError`, with the library's
     /// message (as Rust's `ArmStiffness::evaluate` returns them).
-    #[pyo3(signature = (q, wrench = None, levels = None, policy = None, tensions = None, require_stiffness = false))]
+    ///
+    /// With friction at the holes (spec §9): `friction` (μ at every hole, overriding the
+    /// routing file's), `regime` (`"pull"`, `"release"` or `"stick"`, the default), `history`
+    /// (the stick regime's: `"pull"`, the default, `"release"` or `"equal"`) and `direction`
+    /// (the directional response's force, default the load's) answer a `FrictionResult`, as
+    /// `sinew arm --friction` does; μ = 0 everywhere without `regime="stick"` is the
+    /// frictionless `ArmResult`.
+    #[pyo3(signature = (q, wrench = None, levels = None, policy = None, tensions = None, require_stiffness = false, friction = None, regime = None, history = None, direction = None))]
+    #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
@@ -138,7 +147,11 @@ impl ArmStiffness {
         policy: Option<&str>,
         tensions: Option<&Bound<'py, PyAny>>,
         require_stiffness: bool,
-    ) -> PyResult<ArmResult> {
+        friction: Option<f64>,
+        regime: Option<&str>,
+        history: Option<&str>,
+        direction: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
         let arm = &self.arm;
         let q = vector(q, "q", Some(arm.dof()))?;
         let f0 = wrench_of(wrench)?;
@@ -170,6 +183,12 @@ impl ArmStiffness {
                 &mut fresh
             }
         };
+        let asked = FrictionArgs { mu: friction, regime, history, direction };
+        if let Some((model, regime)) = requested(&asked, arm.routing())? {
+            let (pose, how) = ((&q[..], &f0), (choice, require_stiffness));
+            let out = evaluate_friction(py, (arm, data), (&model, regime), pose, how, direction)?;
+            return Ok(Py::new(py, out)?.into_any());
+        }
         // The Rust part with the GIL released (microseconds for cdhrm5, more for long chains).
         let end = py.detach(|| -> PyResult<_> {
             arm.evaluate_joints(data, &q, &f0, choice).map_err(library)?;
@@ -216,7 +235,7 @@ impl ArmStiffness {
             ellipsoid: OnceLock::new(),
             notes,
         };
-        Ok(result)
+        Ok(Py::new(py, result)?.into_any())
     }
 
     /// Evaluate every row of `Q` (N, dof) under `wrench` (one (6,) for every row, or (N, 6)),

@@ -14,6 +14,7 @@ mod batch_out;
 mod convert;
 mod errors;
 mod export;
+mod friction;
 mod indicators;
 mod lazy;
 mod model;
@@ -41,6 +42,7 @@ fn _sinew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Routing>()?;
     m.add_class::<arm::ArmStiffness>()?;
     m.add_class::<results::ArmResult>()?;
+    m.add_class::<friction::FrictionResult>()?;
     m.add_class::<results::BatchResult>()?;
     m.add_class::<results::PlanResult>()?;
     m.add_class::<plan_many::PlanBatchResult>()?;

@@ -156,3 +156,21 @@ def test_stability_verdict_unstable_drifts_stable_does_not():
     # the default damping), the stable one never strays beyond twice it.
     assert drift["unstable"] > 300 * size, (drift, size)
     assert drift["stable"] < 2 * size, (drift, size)
+
+
+STICK = [c for c in CASES if c[0].startswith("cdhrm5")]
+
+
+@pytest.mark.parametrize("case", STICK, ids=[c[0] for c in STICK])
+def test_segment_springs_are_the_stick_regime(case):
+    """Spec §9's stick model after equal tensions, K_stick = Σ T H_s + Σ J_sᵀ (EA/ℓ_s) J_s,
+    against MuJoCo with one spring tendon per segment (its own rest length and EA/ℓ_s): the
+    static compliance is Sinew's stick C_x, and not the frictionless one."""
+    name, robot, routing, q, r = case
+    arm = sinew.ArmStiffness(robot, routing)
+    stick = arm.evaluate(q, r.wrench, tensions=r.tensions, friction=0.1, history="equal")
+    np.testing.assert_array_equal(stick.tensions, r.tensions)
+    assert stick.stable
+    c = export(case, "segments").compliance()
+    assert rel(c, stick.c_x) <= 1e-10, rel(c, stick.c_x)  # measured 1.6e-11 to 3.1e-11
+    assert rel(c, r.c_x) > 0.5  # far stiffer than the cables as single springs

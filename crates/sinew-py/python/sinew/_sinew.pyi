@@ -17,7 +17,7 @@ file texts; never a path) and evaluate bit for bit like the original when unpick
 
 from collections.abc import Mapping
 from os import PathLike
-from typing import Literal, Optional, Union
+from typing import Any, Literal, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +26,8 @@ ArrayLike = npt.ArrayLike
 F64 = npt.NDArray[np.float64]
 Bool = npt.NDArray[np.bool_]
 Policy = Literal["least-total", "least-norm", "safest"]
+Regime = Literal["pull", "release", "stick"]
+History = Literal["pull", "release", "equal"]
 PlanObjective = Literal[
     "stiffness-along", "compliance-along", "min-stiffness", "volume", "least-tension"
 ]
@@ -121,6 +123,31 @@ def load_robot(dir: Union[str, PathLike[str]], gravity: bool = True) -> Robot:
 
 def load_routing(robot: Robot, path_or_model: str = "decoupled") -> Routing:
     """A routing file's path, or ``"decoupled"``/``"routed"`` (``cables.toml``/``cables-routed.toml``)."""
+
+class FrictionResult:
+    """One evaluation with friction at the holes (``sinew arm --friction --json``'s numbers)."""
+
+    mu: F64
+    regime: Regime
+    history: Optional[History]
+    q: F64
+    wrench: F64
+    t0: F64
+    tensions: F64
+    segments: list[dict[str, Any]]
+    dead_band: F64
+    k_q: F64
+    k_q_skew_norm: float
+    k_w: F64
+    j_x: F64
+    stable: bool
+    min_eigenvalue: float
+    c_x: Optional[F64]
+    k_x: Optional[F64]
+    k_fd: Optional[F64]
+    directional: Optional[dict[str, Any]]
+    stick_load_limit: Optional[list[dict[str, Any]]]
+    notes: list[str]
 
 class ArmResult:
     """One evaluation of the arm (``sinew arm --json``'s numbers). Its numbers are copied when
@@ -245,9 +272,16 @@ class ArmStiffness:
         policy: Optional[Policy] = None,
         tensions: Optional[ArrayLike] = None,
         require_stiffness: bool = False,
-    ) -> ArmResult:
+        friction: Optional[float] = None,
+        regime: Optional[Regime] = None,
+        history: Optional[History] = None,
+        direction: Optional[ArrayLike] = None,
+    ) -> Union[ArmResult, FrictionResult]:
         """Evaluate at ``q`` under ``wrench``; at most one of levels, policy, tensions.
-        ``require_stiffness``: raise UnstableError / RankDeficientError instead of None."""
+        ``require_stiffness``: raise UnstableError / RankDeficientError instead of None.
+        With friction at the holes (``friction`` μ > 0, or the routing file's): a
+        ``FrictionResult`` in ``regime`` (default stick) after ``history`` (default pull);
+        ``direction`` (3,) the directional response's force (default the load's)."""
     def evaluate_many(
         self,
         Q: ArrayLike,
