@@ -85,6 +85,7 @@ pub fn mjcf(args: &MjcfArgs) -> Result<(), CliError> {
         q: &q,
         tensions: &tensions,
         wrench: [wrench[0], wrench[1], wrench[2], wrench[3], wrench[4], wrench[5]],
+        segment_tensions: None,
     };
     let text = sinew_mjcf::to_mjcf(robot, routing, &state, &options)
         .map_err(|e| CliError { kind: e.kind(), message: e.to_string() })?;

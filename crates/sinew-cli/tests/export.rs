@@ -32,7 +32,7 @@ fn load(name: &str, file: &str) -> (sinew::robot::Robot, sinew::routing::Routing
 }
 
 fn state<'a>(q: &'a [f64], f: &'a [f64], w: &Vector6<f64>) -> State<'a> {
-    State { q, tensions: f, wrench: [w[0], w[1], w[2], w[3], w[4], w[5]] }
+    State { q, tensions: f, wrench: [w[0], w[1], w[2], w[3], w[4], w[5]], segment_tensions: None }
 }
 
 fn written(out: &Output, path: &Path) -> String {

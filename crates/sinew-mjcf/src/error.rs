@@ -21,6 +21,14 @@ pub enum MjcfError {
         /// The length given.
         got: usize,
     },
+    /// The segment tensions do not have one entry per routing segment.
+    #[error("segment tensions: expected {expected} (one per segment, routing order), got {got}")]
+    SegmentTensionCount {
+        /// The routing's segment count.
+        expected: usize,
+        /// The length given.
+        got: usize,
+    },
     /// A tension is not finite, or lies outside the cable's limits.
     #[error(
         "cable `{cable}`: tension {} N is outside its limits [{}, {}] N",
@@ -62,6 +70,7 @@ impl MjcfError {
             MjcfError::Robot(e) => e.kind(),
             MjcfError::Routing(e) => e.kind(),
             MjcfError::TensionCount { .. }
+            | MjcfError::SegmentTensionCount { .. }
             | MjcfError::Tension { .. }
             | MjcfError::Wrench { .. }
             | MjcfError::Option { .. } => ErrorKind::Input,

@@ -27,7 +27,8 @@
 //!   model, whose tendon is only the crossing while `K_l` counts the free length: MuJoCo
 //!   refuses `"0 L_u"` there, and the length never falls below a negative `L_u`, so that spring
 //!   also only pulls). The segments of [`Split::Segments`] are springs `E·A/ℓ_s(q)` (spec §9's
-//!   stick model) with the same tension `f`.
+//!   stick model) with the same tension `f`, or each with its own
+//!   ([`State::segment_tensions`]: the stick regime after a pull or a release).
 //! - [`CableModel::Motors`]: tendons without stiffness, `<motor tendon=… gear="-1"
 //!   ctrlrange="f_min f_max"/>` (a positive ctrl with gear 1 would lengthen the tendon): the
 //!   stiffness is then the controllable part `Σ f H_c` only, plus `K_W`.
@@ -114,6 +115,11 @@ pub struct State<'a> {
     pub tensions: &'a [f64],
     /// `F0`, the wrench the tip exerts on its environment, base frame (N, N m; eq. 6).
     pub wrench: [f64; 6],
+    /// With [`Split::Segments`], each segment's own tension (N, one per
+    /// [`Routing::segments`] entry, in that order): the stick regime after a pull or a release
+    /// (spec §9), where the tension changes at every hole. `None`: every segment carries its
+    /// cable's tension (stick after equal tensions).
+    pub segment_tensions: Option<&'a [f64]>,
 }
 
 /// Tensions this far outside a cable's limits (relative to `f_max`) are still accepted:
@@ -126,8 +132,9 @@ const LIMIT_TOLERANCE: f64 = 1e-9;
 /// [`MjcfError::Robot`] for a pose of the wrong length, non-finite or outside the limits;
 /// [`MjcfError::Routing`] for a routing of another robot or a degenerate segment at `q`;
 /// [`MjcfError::TensionCount`], [`MjcfError::Tension`] (non-finite or outside the cable's
-/// limits), [`MjcfError::Wrench`]; [`MjcfError::Option`] for a negative or non-finite damping,
-/// a non-positive time step, or motors with [`Split::Segments`].
+/// limits; a segment's too), [`MjcfError::SegmentTensionCount`], [`MjcfError::Wrench`];
+/// [`MjcfError::Option`] for a negative or non-finite damping, a non-positive time step,
+/// motors with [`Split::Segments`], or segment tensions without it.
 pub fn to_mjcf(
     robot: &Robot,
     routing: &Routing,
@@ -149,6 +156,9 @@ pub fn to_mjcf(
         if !(f.is_finite() && f >= limits[0] - slack && f <= limits[1] + slack) {
             return Err(MjcfError::Tension { cable: cable.name.clone(), tension: f, limits });
         }
+    }
+    if let Some(segments) = state.segment_tensions {
+        check_segment_tensions(routing, segments, options)?;
     }
     if let Some((index, &value)) = state.wrench.iter().enumerate().find(|(_, w)| !w.is_finite()) {
         return Err(MjcfError::Wrench { index, value });
@@ -177,4 +187,32 @@ pub fn to_mjcf(
     let at = write::AtPose { lengths: data.lengths()?, segment_lengths: data.segment_lengths()? };
     let tree = tree::bodies(robot, routing);
     Ok(write::document(robot, routing, &tree, state, &at, options))
+}
+
+/// Segment tensions need [`Split::Segments`], one per routing segment, each within its cable's
+/// limits.
+fn check_segment_tensions(
+    routing: &Routing,
+    tensions: &[f64],
+    options: &MjcfOptions,
+) -> Result<()> {
+    if options.split != Split::Segments {
+        return Err(MjcfError::Option {
+            option: "segment_tensions",
+            reason: "apply to one tendon per segment: use them with split segments".to_owned(),
+        });
+    }
+    let expected = routing.segments().len();
+    if tensions.len() != expected {
+        return Err(MjcfError::SegmentTensionCount { expected, got: tensions.len() });
+    }
+    for (cable, &limits) in routing.cables().iter().zip(routing.cable_limits()) {
+        let slack = LIMIT_TOLERANCE * limits[1].abs().max(1.0);
+        for &t in &tensions[cable.segments.clone()] {
+            if !(t.is_finite() && t >= limits[0] - slack && t <= limits[1] + slack) {
+                return Err(MjcfError::Tension { cable: cable.name.clone(), tension: t, limits });
+            }
+        }
+    }
+    Ok(())
 }

@@ -71,7 +71,7 @@ fn tendons(routing: &Routing, state: &State<'_>, at: &AtPose<'_>, o: &MjcfOption
                         name: format!("{}_s{i}", cable.name),
                         sites: vec![sites[i].clone(), sites[i + 1].clone()],
                         spring: Some((ea / l, l)),
-                        tension: f,
+                        tension: state.segment_tensions.map_or(f, |t| t[s]),
                     });
                 }
             }

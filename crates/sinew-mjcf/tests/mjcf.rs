@@ -34,7 +34,7 @@ fn export(
     options: &MjcfOptions,
 ) -> (Robot, Routing, String) {
     let (robot, routing) = robot_and_routing(model);
-    let state = State { q: &LOADED_POSE, tensions, wrench: WRENCH };
+    let state = State { q: &LOADED_POSE, tensions, wrench: WRENCH, segment_tensions: None };
     let text = to_mjcf(&robot, &routing, &state, options).unwrap();
     (robot, routing, text)
 }
@@ -178,7 +178,7 @@ holes = [
 "#;
     let routing = Routing::from_toml_str(text, "through_cross.toml", &robot).unwrap();
     let q = [0.1; 10];
-    let state = State { q: &q, tensions: &[50.0], wrench: [0.0; 6] };
+    let state = State { q: &q, tensions: &[50.0], wrench: [0.0; 6], segment_tensions: None };
     let xml = to_mjcf(&robot, &routing, &state, &MjcfOptions::default()).unwrap();
     let doc = Document::parse(&xml).unwrap();
     let bodies = elements(&doc, "body");
@@ -284,7 +284,7 @@ fn bad_input_is_a_typed_error_naming_what_is_wrong() {
     let o = MjcfOptions::default();
     let ok = [40.0; 15];
     let run = |q: &[f64], f: &[f64], w: [f64; 6], o: &MjcfOptions| {
-        to_mjcf(&robot, &routing, &State { q, tensions: f, wrench: w }, o)
+        to_mjcf(&robot, &routing, &State { q, tensions: f, wrench: w, segment_tensions: None }, o)
     };
     let mut q = LOADED_POSE;
     q[4] = 0.6;
@@ -292,9 +292,13 @@ fn bad_input_is_a_typed_error_naming_what_is_wrong() {
     assert!(matches!(e, MjcfError::Robot(_)) && e.to_string().contains("joint3_x"), "{e}");
     // A routing of another robot (a 2-joint chain's cables on cdhrm5): the routing's error.
     let (_, other) = sinew_testkit::cdhrm5::chain(2, PatternModel::Decoupled);
-    let e =
-        to_mjcf(&robot, &other, &State { q: &LOADED_POSE, tensions: &ok[..6], wrench: WRENCH }, &o)
-            .unwrap_err();
+    let e = to_mjcf(
+        &robot,
+        &other,
+        &State { q: &LOADED_POSE, tensions: &ok[..6], wrench: WRENCH, segment_tensions: None },
+        &o,
+    )
+    .unwrap_err();
     assert!(matches!(e, MjcfError::Routing(_)), "{e:?}");
     let e = run(&LOADED_POSE, &ok[..14], WRENCH, &o).unwrap_err();
     assert!(matches!(e, MjcfError::TensionCount { expected: 15, got: 14 }), "{e}");
@@ -319,5 +323,48 @@ fn bad_input_is_a_typed_error_naming_what_is_wrong() {
     assert_eq!(
         run(&LOADED_POSE, &ok, WRENCH, &bad).unwrap_err().kind(),
         sinew_robot::ErrorKind::Input
+    );
+}
+
+/// The stick regime after a pull or a release: each segment its own tension, its spring
+/// length set so that it pulls with it; refused without split segments, with the wrong count,
+/// or outside the cable's limits.
+#[test]
+fn segment_tensions_give_each_segment_its_own_tension() {
+    let (robot, routing) = robot_and_routing(PatternModel::Routed);
+    let f = mixed_tensions(15);
+    let own: Vec<f64> =
+        routing.segments().iter().map(|s| f[s.cable] * (1.0 + 0.01 * s.index as f64)).collect();
+    let segments = MjcfOptions { split: Split::Segments, ..MjcfOptions::default() };
+    fn state<'a>(f: &'a [f64], t: &'a [f64]) -> State<'a> {
+        State { q: &LOADED_POSE, tensions: f, wrench: WRENCH, segment_tensions: Some(t) }
+    }
+    let text = to_mjcf(&robot, &routing, &state(&f, &own), &segments).unwrap();
+    let doc = Document::parse(&text).unwrap();
+    let (_, seg) = lengths(&robot, &routing, &LOADED_POSE);
+    let spatial = elements(&doc, "spatial");
+    assert_eq!(spatial.len(), own.len());
+    for (s, t) in spatial.iter().enumerate() {
+        let k = nums(*t, "stiffness")[0];
+        let rest = nums(*t, "springlength")[1];
+        assert!((k * (seg[s] - rest) - own[s]).abs() <= 1e-9 * own[s], "segment {s}");
+    }
+    // Refusals.
+    let e = to_mjcf(&robot, &routing, &state(&f, &own), &MjcfOptions::default()).unwrap_err();
+    assert!(matches!(e, MjcfError::Option { option: "segment_tensions", .. }), "{e}");
+    let e = to_mjcf(&robot, &routing, &state(&f, &own[1..]), &segments).unwrap_err();
+    let n = own.len();
+    assert!(
+        matches!(e, MjcfError::SegmentTensionCount { expected, got } if expected == n && got == n - 1),
+        "{e}"
+    );
+    assert_eq!(e.kind(), sinew_robot::ErrorKind::Input);
+    let mut low = own.clone();
+    low[n - 1] = 5.0;
+    let e = to_mjcf(&robot, &routing, &state(&f, &low), &segments).unwrap_err();
+    let cable = &routing.cables()[routing.segments()[n - 1].cable].name;
+    assert!(
+        matches!(&e, MjcfError::Tension { cable: c, tension, .. } if c == cable && *tension == 5.0),
+        "{e}"
     );
 }

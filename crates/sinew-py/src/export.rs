@@ -17,10 +17,14 @@ use crate::model::{Robot, Routing};
 /// `cables`: "springs" (tendon stiffness K_l = E A / l_c and a spring length giving each
 /// tension at the pose) or "motors" (tendons without stiffness pulled by motors, gear -1,
 /// ctrl = the tensions in the keyframe `exported`). `split="segments"`: one spring per
-/// segment between holes (springs only). `damping`: every hinge's damping, N m s/rad.
+/// segment between holes (springs only); with it, `segment_tensions` gives each segment its
+/// own tension: per cable, the tensions from the actuator to the anchor (the free length
+/// first, as `FrictionResult.segments[c]["tensions"]`: the stick regime after a pull or a
+/// release). `damping`: every hinge's damping, N m s/rad.
 /// The load is not in the model: apply -F0 at site `tip`. Conventions: crate sinew-mjcf.
 #[pyfunction]
-#[pyo3(signature = (robot, routing, q, tensions, wrench=None, *, cables="springs", split=None, damping=sinew_mjcf::DEFAULT_DAMPING))]
+#[pyo3(signature = (robot, routing, q, tensions, wrench=None, *, cables="springs", split=None, damping=sinew_mjcf::DEFAULT_DAMPING, segment_tensions=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn to_mjcf(
     robot: &Robot,
     routing: &Routing,
@@ -30,6 +34,7 @@ pub fn to_mjcf(
     cables: &str,
     split: Option<&str>,
     damping: f64,
+    segment_tensions: Option<Vec<Bound<'_, PyAny>>>,
 ) -> PyResult<String> {
     let q = vector(q, "q", Some(robot.inner.dof()))?;
     let tensions = vector(tensions, "tensions", Some(routing.inner.cable_count()))?;
@@ -48,12 +53,45 @@ pub fn to_mjcf(
         Some(other) => return Err(input(format!("split: `{other}` is not segments"))),
     };
     let options = MjcfOptions { cables, split, damping, ..MjcfOptions::default() };
-    let state = State { q: &q, tensions: &tensions, wrench: [w[0], w[1], w[2], w[3], w[4], w[5]] };
+    let segments = match segment_tensions {
+        Some(per_cable) => Some(flat_segment_tensions(&routing.inner, &per_cable)?),
+        None => None,
+    };
+    let state = State {
+        q: &q,
+        tensions: &tensions,
+        wrench: [w[0], w[1], w[2], w[3], w[4], w[5]],
+        segment_tensions: segments.as_deref(),
+    };
     sinew_mjcf::to_mjcf(&robot.inner, &routing.inner, &state, &options).map_err(|e| match e {
         sinew_mjcf::MjcfError::Robot(e) => library(e),
         sinew_mjcf::MjcfError::Routing(e) => library(e),
         e => exception(e.kind(), e.to_string()),
     })
+}
+
+/// Per cable the tensions from the actuator to the anchor (free length first) as one tension
+/// per routing segment, in the routing's segment order.
+fn flat_segment_tensions(
+    routing: &sinew::routing::Routing,
+    per_cable: &[Bound<'_, PyAny>],
+) -> PyResult<Vec<f64>> {
+    let cables = routing.cables();
+    if per_cable.len() != cables.len() {
+        return Err(input(format!(
+            "segment_tensions: expected {} arrays (one per cable), got {}",
+            cables.len(),
+            per_cable.len()
+        )));
+    }
+    let mut out = vec![0.0; routing.segments().len()];
+    for (cable, given) in cables.iter().zip(per_cable) {
+        let n = cable.segments.len();
+        let name = format!("segment_tensions of cable `{}`", cable.name);
+        let t = vector(given, &name, Some(n + 1))?;
+        out[cable.segments.clone()].copy_from_slice(&t[1..]);
+    }
+    Ok(out)
 }
 
 /// The cable lengths `L_c(q)` (m, routing order) and the cable Jacobian `J_c = ∂L/∂Q`

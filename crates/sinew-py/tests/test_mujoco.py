@@ -174,3 +174,41 @@ def test_segment_springs_are_the_stick_regime(case):
     c = export(case, "segments").compliance()
     assert rel(c, stick.c_x) <= 1e-10, rel(c, stick.c_x)  # measured 1.6e-11 to 3.1e-11
     assert rel(c, r.c_x) > 0.5  # far stiffer than the cables as single springs
+
+
+@pytest.mark.parametrize("case", STICK, ids=[c[0] for c in STICK])
+@pytest.mark.parametrize("history", ["pull", "release"])
+def test_segment_springs_with_their_own_tensions_are_the_stick_regime_after_a_history(case, history):
+    """After a pull or a release the tension changes at every hole (the capstan law): each
+    segment's spring exported with its own tension holds the pose, and MuJoCo's static
+    compliance is Sinew's stick C_x after that history."""
+    name, robot, routing, q, r = case
+    arm = sinew.ArmStiffness(robot, routing)
+    stick = arm.evaluate(q, r.wrench, policy="safest", friction=0.1, regime="stick", history=history)
+    assert stick.stable
+    per_segment = [s["tensions"] for s in stick.segments]
+    assert any(np.ptp(t) > 1e-3 * t[0] for t in per_segment), "the tensions change along the cables"
+    xml = sinew.to_mjcf(robot, routing, q, stick.tensions, stick.wrench, split="segments",
+                        segment_tensions=per_segment)
+    sim = Exported(xml)
+    assert np.linalg.norm(sim.residual(sim.q0)) <= 1e-9 * np.linalg.norm(sim.gravity_torque())
+    c = sim.compliance()
+    assert rel(c, stick.c_x) <= 1e-10, rel(c, stick.c_x)
+
+
+def test_segment_tensions_are_checked():
+    _, robot, routing, q, r = STICK[0]
+    per_cable = [np.full(len(s["tensions"]), t) for s, t in zip(
+        sinew.ArmStiffness(robot, routing).evaluate(q, r.wrench, tensions=r.tensions, friction=0.1,
+                                                     history="equal").segments, r.tensions)]
+    with pytest.raises(sinew.InputError, match="segment_tensions"):
+        sinew.to_mjcf(robot, routing, q, r.tensions, r.wrench, split="segments", segment_tensions=per_cable[1:])
+    with pytest.raises(sinew.InputError, match="segment_tensions of cable"):
+        sinew.to_mjcf(robot, routing, q, r.tensions, r.wrench, split="segments",
+                      segment_tensions=[t[1:] for t in per_cable])
+    with pytest.raises(sinew.InputError, match="segment_tensions"):
+        sinew.to_mjcf(robot, routing, q, r.tensions, r.wrench, segment_tensions=per_cable)
+    # Equal tensions along each cable give the file of no segment tensions.
+    plain = sinew.to_mjcf(robot, routing, q, r.tensions, r.wrench, split="segments")
+    same = sinew.to_mjcf(robot, routing, q, r.tensions, r.wrench, split="segments", segment_tensions=per_cable)
+    assert same == plain

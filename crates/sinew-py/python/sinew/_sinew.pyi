@@ -404,10 +404,12 @@ def to_mjcf(
     cables: str = "springs",
     split: Optional[str] = None,
     damping: float = 1.0,
+    segment_tensions: Optional[list[ArrayLike]] = None,
 ) -> str:
     """The MJCF text of the robot at ``q`` held by ``tensions`` (N, routing order); ``cables``
-    "springs" or "motors", ``split="segments"`` for one spring per segment. Apply ``-wrench``
-    at site ``tip`` to hold the pose."""
+    "springs" or "motors", ``split="segments"`` for one spring per segment, and with it
+    ``segment_tensions`` (per cable, actuator to anchor, as ``FrictionResult.segments``) for
+    each segment's own tension. Apply ``-wrench`` at site ``tip`` to hold the pose."""
     ...
 def cable_geometry(robot: Robot, routing: Routing, q: ArrayLike) -> tuple[F64, F64]:
     """``(lengths, j_c)`` at ``q``: the cable lengths (m) and ``J_c = dL/dQ`` (cables x dof)."""
