@@ -51,14 +51,15 @@ pub fn compute_friction_geometry(
         let first = range.start;
         // Hole positions, then each segment's length, direction and J_s.
         for (s, entry) in entries.iter().enumerate() {
-            let frame = kinematics.0.get(entry.hole_body).ok_or(mismatch(model.dof))?;
+            let frame = kinematics.0.get(entry.hole_body).ok_or_else(|| mismatch(model.dof))?;
             data.positions[first + s] = transform(frame, &entry.hole_point);
         }
-        let entry_frame = kinematics.0.get(entries[0].hole_body).ok_or(mismatch(model.dof))?;
+        let entry_frame =
+            kinematics.0.get(entries[0].hole_body).ok_or_else(|| mismatch(model.dof))?;
         data.lengths[first] = model.free_length[c];
         data.directions[first] = rotate(entry_frame, &model.entry_direction[c]);
         for (s, entry) in entries.iter().enumerate().skip(1) {
-            let r = entry.routing.ok_or(mismatch(model.dof))?;
+            let r = entry.routing.ok_or_else(|| mismatch(model.dof))?;
             let length = segment_lengths[r];
             let u = segment(routing, r, entry, kinematics, &data.positions[first + s - 1..], {
                 let slot = &entry.jacobian;

@@ -232,17 +232,18 @@ impl FrictionModel {
 
     /// Entry `s` of cable `c`.
     pub(crate) fn entry(&self, c: usize, s: usize) -> Result<&Entry> {
-        let range = self
-            .cables
-            .get(c)
-            .ok_or(RoutingError::NoSuchCable { cable: c, cables: self.cables.len() })?;
-        self.entries.get(range.start + s).filter(|_| s < range.len()).ok_or(
-            RoutingError::DimensionMismatch {
+        // Matches, not `ok_or`: that builds (and drops) the error on every call.
+        let Some(range) = self.cables.get(c) else {
+            return Err(RoutingError::NoSuchCable { cable: c, cables: self.cables.len() });
+        };
+        match self.entries.get(range.start + s).filter(|_| s < range.len()) {
+            Some(entry) => Ok(entry),
+            None => Err(RoutingError::DimensionMismatch {
                 what: "friction segment or hole index",
                 expected: range.len(),
                 got: s,
-            },
-        )
+            }),
+        }
     }
 
     /// Check that the model was built for `routing` (its DOFs, cables and segments).

@@ -153,11 +153,15 @@ impl RoutingData {
     pub fn segment_hessian<'a>(&'a self, routing: &Routing, s: usize) -> Result<MatRef<'a, f64>> {
         self.check(routing)?;
         self.need(Order::Hessians, "cable Hessians")?;
-        hessian_block(routing, &self.hessians, s).ok_or(RoutingError::DimensionMismatch {
-            what: "segment index",
-            expected: routing.segments.len(),
-            got: s,
-        })
+        // A match, not `ok_or`: that builds (and drops) the error on every call.
+        match hessian_block(routing, &self.hessians, s) {
+            Some(block) => Ok(block),
+            None => Err(RoutingError::DimensionMismatch {
+                what: "segment index",
+                expected: routing.segments.len(),
+                got: s,
+            }),
+        }
     }
 
     /// Every segment's Hessian block, with the workspace checked against `routing` once: for
@@ -186,10 +190,9 @@ impl RoutingData {
     ) -> Result<()> {
         self.check(routing)?;
         self.need(Order::Hessians, "cable Hessians")?;
-        let cable = routing
-            .cables
-            .get(c)
-            .ok_or(RoutingError::NoSuchCable { cable: c, cables: routing.cables.len() })?;
+        let Some(cable) = routing.cables.get(c) else {
+            return Err(RoutingError::NoSuchCable { cable: c, cables: routing.cables.len() });
+        };
         check_shape("cable Hessian", out.nrows(), out.ncols(), self.dof, self.dof)?;
         out.fill(0.0);
         for s in cable.segments.clone() {
