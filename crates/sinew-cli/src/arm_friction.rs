@@ -12,8 +12,9 @@ use sinew::stiffness::{
     stick_load_limits,
 };
 
-use crate::cli::{ArmArgs, FrictionArgs, HistoryArg, Regime};
+use crate::cli::ArmArgs;
 use crate::error::{CliError, library_error};
+use crate::friction_args::{FrictionArgs, HistoryArg, Regime};
 use crate::input::{Loaded, levels, numbers_n, pose, tension_choice, wrench};
 use crate::output::{
     Fmt, Rows, Table, cartesian_labels, emit, faer_rows, matrix, na_rows, print_json, q_labels,

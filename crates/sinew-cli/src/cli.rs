@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::friction_args::FrictionArgs;
+
 /// Stiffness of cable-driven hyper-redundant manipulators, from a robot folder.
 ///
 /// SI units throughout (m, rad, N, N m, N/m, N m/rad). Universal joints are numbered from 1
@@ -296,50 +298,6 @@ pub struct ArmArgs {
     pub deg: bool,
     #[command(flatten)]
     pub friction: FrictionArgs,
-}
-
-/// Friction at the holes (spec §9): used when the routing file or `--friction` gives some
-/// cable μ > 0; with μ = 0 everywhere the frictionless model, exactly.
-#[derive(Debug, Args)]
-pub struct FrictionArgs {
-    /// The friction coefficient μ ≥ 0 of every cable at every hole (overrides the routing
-    /// file's).
-    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
-    pub friction: Option<f64>,
-    /// The regime: every hole sliding toward the actuator (pull) or away from it (release), or
-    /// no hole sliding (stick, the default).
-    #[arg(long, value_enum)]
-    pub regime: Option<Regime>,
-    /// How the tensions of a sticking cable were left: by a pull (the default), a release, or
-    /// equal along each cable.
-    #[arg(long, value_enum)]
-    pub history: Option<HistoryArg>,
-    /// The force direction of the directional response and of one more stick load limit:
-    /// UX,UY,UZ (base frame, any non-zero length). Default: the force part of --wrench.
-    #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
-    pub direction: Option<String>,
-}
-
-/// `--regime`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Regime {
-    /// Every hole slides toward the actuator.
-    Pull,
-    /// Every hole slides away from the actuator.
-    Release,
-    /// No hole slides.
-    Stick,
-}
-
-/// `--history`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum HistoryArg {
-    /// Last pulled in: every hole on the lower edge of its band.
-    Pull,
-    /// Last released: every hole on the upper edge.
-    Release,
-    /// Equal tensions along each cable.
-    Equal,
 }
 
 /// How `sinew arm` and `sinew export mjcf` choose the tensions: levels or a policy.

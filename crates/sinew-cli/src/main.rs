@@ -17,6 +17,7 @@ mod arm_friction;
 mod cli;
 mod error;
 mod export_cmd;
+mod friction_args;
 mod import_cmd;
 mod input;
 mod joint_cmd;

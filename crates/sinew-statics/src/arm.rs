@@ -117,6 +117,11 @@ impl ArmStatics {
         self.limits
     }
 
+    /// Every cable's name, routing order (what the refusals name).
+    pub fn cable_names(&self) -> &[String] {
+        &self.cable_names
+    }
+
     /// `[f_min, f_max]` of every cable, N.
     pub fn cable_limits(&self) -> &[[f64; 2]] {
         &self.cable_limits

@@ -125,28 +125,12 @@ impl ArmStiffness {
         let geometry = &data.cables;
         match regime {
             FrictionRegime::Slip(slip) => {
-                let args = (model, routing, geometry, &out.friction);
-                slip_stiffness(
-                    args.0,
-                    args.1,
-                    args.2,
-                    args.3,
-                    slip,
-                    &out.actuator,
-                    &mut out.stiffness,
-                )?
+                let (f, t, k) = (&out.friction, &out.actuator, &mut out.stiffness);
+                slip_stiffness(model, routing, geometry, f, slip, t, k)?
             }
             FrictionRegime::Stick(history) => {
-                let args = (model, routing, geometry, &out.friction);
-                stick_stiffness(
-                    args.0,
-                    args.1,
-                    args.2,
-                    args.3,
-                    history,
-                    &out.actuator,
-                    &mut out.stiffness,
-                )?
+                let (f, t, k) = (&out.friction, &out.actuator, &mut out.stiffness);
+                stick_stiffness(model, routing, geometry, f, history, t, k)?
             }
         }
         data.fill_k_w();
@@ -177,7 +161,7 @@ impl ArmStiffness {
         choice: TensionChoice<'_>,
     ) -> Result<(), StiffnessError> {
         let statics = self.statics();
-        let names: Vec<String> = self.routing().cables().iter().map(|c| c.name.clone()).collect();
+        let names = statics.cable_names();
         let policy = match choice {
             TensionChoice::Levels(levels) => {
                 let closed_form = (statics.closed_form()?, statics.limits());
@@ -190,7 +174,7 @@ impl ArmStiffness {
                 let mut limits = vec![[0.0; 2]; model.cable_count()];
                 actuator_limits(model, &out.friction, statics.cable_limits(), &mut limits)?;
                 let j_tilde = out.friction.effective_jacobian()?;
-                check_balance(j_tilde, &data.statics.t0, &limits, &names, tensions)?;
+                check_balance(j_tilde, &data.statics.t0, &limits, names, tensions)?;
                 out.actuator.copy_from_slice(tensions);
                 return Ok(());
             }
@@ -204,7 +188,7 @@ impl ArmStiffness {
             statics.cable_limits(),
             statics.joint_groups(),
         )?;
-        distribute_with_policy(&set, policy, statics.joint_groups(), &names, &mut out.actuator)?;
+        distribute_with_policy(&set, policy, statics.joint_groups(), names, &mut out.actuator)?;
         Ok(())
     }
 }

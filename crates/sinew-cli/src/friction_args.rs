@@ -1,0 +1,48 @@
+//! The friction options of `sinew arm` (spec §9): `--friction`, `--regime`, `--history`,
+//! `--direction` (clap derive), flattened into `ArmArgs`.
+
+use clap::{Args, ValueEnum};
+
+/// Friction at the holes (spec §9): used when the routing file or `--friction` gives some
+/// cable μ > 0; with μ = 0 everywhere the frictionless model, exactly.
+#[derive(Debug, Args)]
+pub struct FrictionArgs {
+    /// The friction coefficient μ ≥ 0 of every cable at every hole (overrides the routing
+    /// file's).
+    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
+    pub friction: Option<f64>,
+    /// The regime: every hole sliding toward the actuator (pull) or away from it (release), or
+    /// no hole sliding (stick, the default).
+    #[arg(long, value_enum)]
+    pub regime: Option<Regime>,
+    /// How the tensions of a sticking cable were left: by a pull (the default), a release, or
+    /// equal along each cable.
+    #[arg(long, value_enum)]
+    pub history: Option<HistoryArg>,
+    /// The force direction of the directional response and of one more stick load limit:
+    /// UX,UY,UZ (base frame, any non-zero length). Default: the force part of --wrench.
+    #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
+    pub direction: Option<String>,
+}
+
+/// `--regime`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Regime {
+    /// Every hole slides toward the actuator.
+    Pull,
+    /// Every hole slides away from the actuator.
+    Release,
+    /// No hole slides.
+    Stick,
+}
+
+/// `--history`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum HistoryArg {
+    /// Last pulled in: every hole on the lower edge of its band.
+    Pull,
+    /// Last released: every hole on the upper edge.
+    Release,
+    /// Equal tensions along each cable.
+    Equal,
+}
