@@ -127,9 +127,9 @@ pub enum RobotError {
         /// The upper limit, rad.
         upper: f64,
     },
-    /// A link with a negative (or non-finite) mass.
+    /// A link with a negative, non-finite or absurd (> 1e9 kg) mass.
     #[error(
-        "{source_name}: link `{link}` has mass {} kg; mass must be finite and non-negative",
+        "{source_name}: link `{link}` has mass {} kg; mass must be finite, non-negative and at most 1e9 kg",
         Compact(*.mass)
     )]
     InvalidMass {
@@ -140,8 +140,9 @@ pub enum RobotError {
         /// Its mass, kg.
         mass: f64,
     },
-    /// A number in the description is NaN or infinite where a finite value is needed.
-    #[error("{source_name}: {element}: `{field}` is not finite")]
+    /// A number in the description is NaN, infinite or beyond ±1e9 where a finite value is
+    /// needed.
+    #[error("{source_name}: {element}: `{field}` is not finite (or beyond ±1e9)")]
     NonFinite {
         /// The file.
         source_name: String,

@@ -20,8 +20,13 @@ fn pose(p: &urdf_rs::Pose) -> IsometryMatrix3<f64> {
     IsometryMatrix3::from_parts(Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]), rotation)
 }
 
+/// The largest magnitude a URDF number may have (m, rad, kg, kg m²). Beyond it no arm is
+/// described, and products of such numbers (a torque: mass × gravity × lever arm) overflow to
+/// infinity: `1e308` in an origin once loaded and gave an infinite gravity torque.
+pub(crate) const MAX_MAGNITUDE: f64 = 1e9;
+
 fn all_finite(values: &[f64]) -> bool {
-    values.iter().all(|v| v.is_finite())
+    values.iter().all(|v| v.is_finite() && v.abs() <= MAX_MAGNITUDE)
 }
 
 impl Robot {
@@ -78,7 +83,7 @@ impl Builder<'_> {
         for link in &self.urdf.links {
             let inertial = &link.inertial;
             let mass = inertial.mass.value;
-            if !mass.is_finite() || mass < 0.0 {
+            if !mass.is_finite() || !(0.0..=MAX_MAGNITUDE).contains(&mass) {
                 return Err(RobotError::InvalidMass {
                     source_name: self.source.to_owned(),
                     link: link.name.clone(),

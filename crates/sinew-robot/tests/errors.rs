@@ -198,17 +198,36 @@ fn non_finite_urdf_values_name_the_element_and_field() {
         matches!(err, RobotError::NonFinite { ref element, ref field, .. } if element == "joint `j2`" && field == "origin"),
         "{err:?}"
     );
-    assert_eq!(err.to_string(), "test.urdf: joint `j2`: `origin` is not finite");
+    assert_eq!(err.to_string(), "test.urdf: joint `j2`: `origin` is not finite (or beyond ±1e9)");
     // A joint axis.
     let err = load(&urdf("revolute", "base", "nan 0 1", "0.5", "")).unwrap_err();
-    assert_eq!(err.to_string(), "test.urdf: joint `j1`: `axis` is not finite");
+    assert_eq!(err.to_string(), "test.urdf: joint `j1`: `axis` is not finite (or beyond ±1e9)");
     // A link's inertia and its inertial origin.
     let err = load(&valid().replacen(r#"ixx="1e-3""#, r#"ixx="NaN""#, 1)).unwrap_err();
     assert!(matches!(err, RobotError::NonFinite { .. }), "{err:?}");
-    assert_eq!(err.to_string(), "test.urdf: link `l1` inertial: `inertia` is not finite");
+    assert_eq!(
+        err.to_string(),
+        "test.urdf: link `l1` inertial: `inertia` is not finite (or beyond ±1e9)"
+    );
     let err = load(&valid().replacen(r#"xyz="0 0 0.1"/><mass"#, r#"xyz="0 -inf 0.1"/><mass"#, 1))
         .unwrap_err();
-    assert_eq!(err.to_string(), "test.urdf: link `l1` inertial: `origin` is not finite");
+    assert_eq!(
+        err.to_string(),
+        "test.urdf: link `l1` inertial: `origin` is not finite (or beyond ±1e9)"
+    );
+    // Finite but absurd: a torque of 1e308 m × 0.5 kg × 9.81 m/s² overflows (proptest found
+    // `xyz="0 01e308 0.1"`, which loaded and gave an infinite gravity torque).
+    let err = load(&valid().replacen(r#"xyz="0 0 0.1"/><mass"#, r#"xyz="0 1e308 0.1"/><mass"#, 1))
+        .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "test.urdf: link `l1` inertial: `origin` is not finite (or beyond ±1e9)"
+    );
+    assert!(
+        load(&valid().replacen(r#"xyz="0 0 0.1"/><mass"#, r#"xyz="0 1e9 0.1"/><mass"#, 1)).is_ok()
+    );
+    let err = load(&urdf("revolute", "base", "1 0 0", "2e9", "")).unwrap_err();
+    assert!(matches!(err, RobotError::InvalidMass { mass, .. } if mass == 2e9), "{err:?}");
 }
 
 #[test]
