@@ -76,7 +76,7 @@ impl crate::Planner {
                 }
             }
         }
-        data.previous = None;
+        data.forget();
         let change = rate.map(|r| r.max_change());
         let mut out = Vec::with_capacity(steps.len());
         for step in steps {

@@ -88,7 +88,8 @@ impl Frame {
         let symmetric = |a: &faer::Mat<f64>, scale: f64, out: &mut [f64]| {
             for c in 0..n {
                 let column = a.col_as_slice(c);
-                for (r, v) in column.iter().enumerate() {
+                // A decoupled `A_i` is one 2 × 2 joint block: skip its zeros.
+                for (r, v) in column.iter().enumerate().filter(|(_, v)| **v != 0.0) {
                     out[r * n + c] += 0.5 * scale * v;
                     out[c * n + r] += 0.5 * scale * v;
                 }
@@ -118,16 +119,20 @@ impl Frame {
             }
         }
         let k = free.len();
-        let (mut rows, mut rhs) = (Vec::new(), Vec::new());
+        let (mut rows, mut rhs) =
+            (Vec::with_capacity(linear.rhs.len() * k), Vec::with_capacity(linear.rhs.len()));
         for (row, h) in linear.rows().zip(&linear.rhs) {
             let shift: f64 = row.iter().zip(&base).map(|(a, b)| a * b).sum();
-            let g: Vec<f64> = free.iter().zip(&width).map(|(&i, w)| row[i] * w).collect();
+            let start = rows.len();
+            rows.extend(free.iter().zip(&width).map(|(&i, w)| row[i] * w));
+            let g = &mut rows[start..];
             let scale = g.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             if scale <= 1e-14 * row.iter().fold(0.0_f64, |a, v| a.max(v.abs())).max(1e-300) {
                 // A row on held coordinates only: a constant, checked by the caller's start.
+                rows.truncate(start);
                 continue;
             }
-            rows.extend(g.iter().map(|v| v / scale));
+            g.iter_mut().for_each(|v| *v /= scale);
             rhs.push((h - shift) / scale);
         }
         let column_sums = crate::rows::column_sums(set);

@@ -48,6 +48,7 @@ mod error;
 mod frame;
 mod interior;
 mod ipm;
+mod least;
 mod pencil;
 mod phases;
 mod plan;

@@ -6,13 +6,14 @@
 
 use nalgebra::{Matrix6, Vector6};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
-use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome, StiffnessError};
 
 use crate::active;
 use crate::bundle::{self, Linear};
 use crate::error::{InputProblem, PlanError};
 use crate::frame::Frame;
 use crate::interior;
+use crate::least::LeastEigen;
 use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
@@ -38,6 +39,8 @@ pub struct PlannerData {
     active: Option<(usize, Vec<usize>)>,
     /// The last plan's pencil, its buffers reused by the next.
     pencil: Option<Pencil>,
+    /// The answer's `sym(K_q + K_W)` (row-major) and its least eigenvalue's workspace.
+    margin: (Vec<f64>, LeastEigen),
 }
 
 impl PlannerData {
@@ -48,7 +51,15 @@ impl PlannerData {
             previous: None,
             active: None,
             pencil: None,
+            margin: (Vec::new(), LeastEigen::default()),
         }
+    }
+
+    /// Forget the previous plan (its tensions and the margin's last eigenvector): the next
+    /// plan is cold and depends on its own arguments only.
+    pub(crate) fn forget(&mut self) {
+        self.previous = None;
+        self.margin.1.forget();
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
@@ -88,7 +99,7 @@ impl Planner {
         requirements: &Requirements,
         settings: &PlanSettings,
     ) -> Result<Plan, PlanError> {
-        data.previous = None;
+        data.forget();
         self.plan_step(data, q, f0, objective, requirements, settings, None).map(|(p, _, _)| p)
     }
 
@@ -206,15 +217,7 @@ impl Planner {
             }
         };
         data.pencil = Some(pencil);
-        let plan = self.answer(
-            &mut data.stiffness,
-            &set,
-            objective,
-            requirements,
-            &lambda,
-            upper,
-            iterations,
-        )?;
+        let plan = self.answer(data, &set, objective, requirements, &lambda, upper, iterations)?;
         data.previous = Some(plan.tensions.clone());
         Ok((plan, warm, iterations))
     }
@@ -275,7 +278,7 @@ impl Planner {
     #[allow(clippy::too_many_arguments)]
     fn answer(
         &self,
-        sd: &mut ArmStiffnessData,
+        data: &mut PlannerData,
         set: &EquilibriumSet,
         objective: Objective,
         requirements: &Requirements,
@@ -289,10 +292,14 @@ impl Planner {
         for (f, (lo, hi)) in tensions.iter_mut().zip(set.lower().iter().zip(set.upper())) {
             *f = f.clamp(*lo, *hi);
         }
+        let sd = &mut data.stiffness;
         arm.set_tensions(sd, TensionChoice::Given(&tensions))?;
         arm.solve_end(sd)?;
+        let min_eigenvalue = match sd.outcome().ok_or(PlanError::NoEndStiffness)?.end() {
+            EndOutcome::Unstable { min_eigenvalue } => min_eigenvalue,
+            _ => stable_margin(sd, &mut data.margin)?,
+        };
         let outcome = sd.outcome().ok_or(PlanError::NoEndStiffness)?;
-        let min_eigenvalue = outcome.margin()?;
         let Some(c) = outcome.compliance() else {
             return Err(PlanError::NoStableTensions {
                 margin: requirements.margin,
@@ -414,4 +421,31 @@ impl Planner {
         let routing = self.arm.routing();
         requirements.joint_budgets.iter().map(|&(j, b)| (routing.cables_of_joint(j), b)).collect()
     }
+}
+
+/// The stability margin of the stable arm in `sd` (its last end stage), as
+/// [`sinew_stiffness::Outcome::margin`] defines it, the least eigenvalue of `sym(K_q + K_W)`,
+/// by Cholesky trials instead of an eigendecomposition ([`LeastEigen`]; no allocation once
+/// `margin` is sized; its last eigenvector starts the next plan's).
+fn stable_margin(
+    sd: &mut ArmStiffnessData,
+    (a, least): &mut (Vec<f64>, LeastEigen),
+) -> Result<f64, PlanError> {
+    let n = sd.k_q().nrows();
+    a.resize(n * n, 0.0);
+    let k_q = sd.k_q();
+    for (i, row) in a.chunks_exact_mut(n).enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = k_q[(i, j)];
+        }
+    }
+    let k_w = sd.k_w();
+    for (i, row) in a.chunks_exact_mut(n).enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v += k_w[(i, j)];
+        }
+    }
+    crate::dense::symmetrise(a, n);
+    // Stable: λ_min > 0.
+    Ok(least.least(a, n, Some(0.0)).ok_or(StiffnessError::Eigen)?)
 }

@@ -129,7 +129,9 @@ pub struct Plan {
     pub k_fd: Option<Matrix3<f64>>,
     /// `C_x` at the answer (6 × 6).
     pub c_x: nalgebra::Matrix6<f64>,
-    /// `λ_min(K_q + K_W)` at the answer, N m/rad.
+    /// `λ_min(K_q + K_W)` at the answer (its symmetric part), N m/rad: the pipeline's
+    /// matrices, the eigenvalue bracketed by Cholesky trials to `1e-10 max |a_ij|` (the value
+    /// itself a Rayleigh quotient, agreeing with a full eigensolve to about `1e-14 max |a_ij|`).
     pub min_eigenvalue: f64,
     /// Iterations of the method (both phases).
     pub iterations: usize,
