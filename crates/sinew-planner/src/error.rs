@@ -205,6 +205,8 @@ pub enum InputProblem {
     },
     /// Held levels on a routing without the decoupled closed form.
     FixedLevelsNeedDecoupled,
+    /// An option the stick regime's planner does not offer (held levels, the bundle method).
+    NotInStick,
 }
 
 impl std::fmt::Display for InputProblem {
@@ -227,6 +229,10 @@ impl std::fmt::Display for InputProblem {
                 f,
                 "joint {} at level {level}: joints are 1 to {joints}, levels in [0, 1]",
                 joint + 1
+            ),
+            InputProblem::NotInStick => write!(
+                f,
+                "is not offered when planning in the stick regime (the interior-point method, budgets and floors are)"
             ),
             InputProblem::FixedLevelsNeedDecoupled => write!(
                 f,

@@ -38,6 +38,7 @@
 
 mod active;
 mod along;
+mod answer;
 mod block_work;
 mod blocks;
 mod bundle;
@@ -57,6 +58,7 @@ mod program;
 mod rows;
 mod sdp;
 mod smooth;
+mod stick_plan;
 
 pub use along::{AlongStep, RateLimit, Step};
 pub use error::{InputProblem, PlanError};
@@ -64,3 +66,4 @@ pub use plan::{Planner, PlannerData};
 pub use problem::{
     DEFAULT_GAP, DEFAULT_MARGIN, Method, Objective, Plan, PlanSettings, Requirements,
 };
+pub use stick_plan::StickPlanData;

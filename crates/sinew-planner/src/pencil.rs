@@ -16,8 +16,12 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Side};
 use nalgebra::{Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
 
+use sinew_routing::{FrictionData, FrictionModel};
 use sinew_statics::EquilibriumSet;
-use sinew_stiffness::{ArmStiffness, ArmStiffnessData, compliance_inverse};
+use sinew_stiffness::{
+    ArmStiffness, ArmStiffnessData, FrictionStiffnessData, History, compliance_inverse,
+    stick_stiffness,
+};
 
 use crate::error::PlanError;
 
@@ -54,21 +58,9 @@ impl Pencil {
     ) -> Result<(), PlanError> {
         let routing = arm.routing();
         let dof = arm.dof();
-        let k = set.dimension();
-        let reset = |a: &mut Mat<f64>| {
-            if a.nrows() == dof && a.ncols() == dof {
-                a.fill(0.0);
-            } else {
-                *a = Mat::zeros(dof, dof);
-            }
-        };
-        reset(&mut self.a0);
-        self.ai.truncate(k);
-        self.ai.iter_mut().for_each(reset);
-        self.ai.resize_with(k, || Mat::zeros(dof, dof));
+        self.size(dof, set.dimension());
         // Σ f_p,c H_c, then K_i + K_W entry by entry.
         sd.cables.add_weighted_hessians(routing, set.particular(), self.a0.as_mut())?;
-        reset(&mut self.k_w);
         self.k_w.copy_from(sd.k_w());
         let k_inherent = sd.k_inherent();
         for c in 0..dof {
@@ -84,13 +76,72 @@ impl Pencil {
             }
             sd.cables.add_weighted_hessians(routing, &self.weights, a.as_mut())?;
         }
-        let j_x = sd.j_x();
-        if self.j_x.nrows() == 6 && self.j_x.ncols() == dof {
+        self.copy_j_x(sd.j_x());
+        Ok(())
+    }
+
+    /// The pencil of the stick regime after `history` (spec §9): `A(λ) = K_stick(f_p + N λ) +
+    /// K_W`, affine in the actuator tensions because the segment tensions are theirs times the
+    /// history's weights (`T_s = T_0 w_s`) and the segment springs do not depend on them:
+    /// `A_0 = K_stick(f_p) + K_W` and `A_i` the controllable part at the tensions `N e_i`
+    /// ([`sinew_stiffness::stick_stiffness`], which takes any real tensions). `set` is the
+    /// equilibrium set of the regime's statics (through `J̃` after a pull or a release) and
+    /// `friction` the friction geometry at the pose of `sd`, with the history's weights.
+    pub(crate) fn fill_stick(
+        &mut self,
+        arm: &ArmStiffness,
+        sd: &mut ArmStiffnessData,
+        (model, friction, history): (&FrictionModel, &FrictionData, History),
+        set: &EquilibriumSet,
+        scratch: &mut FrictionStiffnessData,
+    ) -> Result<(), PlanError> {
+        let routing = arm.routing();
+        let dof = arm.dof();
+        self.size(dof, set.dimension());
+        let geometry = &sd.cables;
+        stick_stiffness(model, routing, geometry, friction, history, set.particular(), scratch)?;
+        self.a0.copy_from(scratch.stiffness()?);
+        let null = set.null_basis();
+        self.weights.resize(set.cable_count(), 0.0);
+        for (i, a) in self.ai.iter_mut().enumerate() {
+            for (c, w) in self.weights.iter_mut().enumerate() {
+                *w = null[(c, i)];
+            }
+            stick_stiffness(model, routing, geometry, friction, history, &self.weights, scratch)?;
+            a.copy_from(scratch.controllable()?);
+        }
+        self.k_w.copy_from(sd.k_w());
+        for c in 0..dof {
+            for r in 0..dof {
+                self.a0[(r, c)] += self.k_w[(r, c)];
+            }
+        }
+        self.copy_j_x(sd.j_x());
+        Ok(())
+    }
+
+    /// `A_0`, `K_W` and `k` coefficients of `dof × dof`, zero.
+    fn size(&mut self, dof: usize, k: usize) {
+        let reset = |a: &mut Mat<f64>| {
+            if a.nrows() == dof && a.ncols() == dof {
+                a.fill(0.0);
+            } else {
+                *a = Mat::zeros(dof, dof);
+            }
+        };
+        reset(&mut self.a0);
+        reset(&mut self.k_w);
+        self.ai.truncate(k);
+        self.ai.iter_mut().for_each(reset);
+        self.ai.resize_with(k, || Mat::zeros(dof, dof));
+    }
+
+    fn copy_j_x(&mut self, j_x: MatRef<'_, f64>) {
+        if self.j_x.nrows() == j_x.nrows() && self.j_x.ncols() == j_x.ncols() {
             self.j_x.copy_from(j_x);
         } else {
             self.j_x = j_x.to_owned();
         }
-        Ok(())
     }
 
     /// A pencil with no buffers yet ([`Pencil::fill`] sizes them).

@@ -6,9 +6,10 @@
 
 use nalgebra::{Matrix6, Vector6};
 use sinew_statics::{EquilibriumSet, TensionChoice, TensionPolicy};
-use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome, StiffnessError};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome};
 
 use crate::active;
+use crate::answer::{Evaluated, plan_at, stable_margin};
 use crate::bundle::{self, Linear};
 use crate::error::{InputProblem, PlanError};
 use crate::frame::Frame;
@@ -31,16 +32,16 @@ pub struct Planner {
 /// The planner's workspace.
 #[derive(Debug)]
 pub struct PlannerData {
-    stiffness: ArmStiffnessData,
+    pub(crate) stiffness: ArmStiffnessData,
     /// The last plan's tensions, for a rate limit and a warm start along a trajectory.
     pub(crate) previous: Option<Vec<f64>>,
     /// The last interior-point plan's active rows, with the number of rows of its frame (the
     /// warm start's first active set when this frame has as many).
     active: Option<(usize, Vec<usize>)>,
     /// The last plan's pencil, its buffers reused by the next.
-    pencil: Option<Pencil>,
+    pub(crate) pencil: Option<Pencil>,
     /// The answer's `sym(K_q + K_W)` (row-major) and its least eigenvalue's workspace.
-    margin: (Vec<f64>, LeastEigen),
+    pub(crate) margin: (Vec<f64>, LeastEigen),
 }
 
 impl PlannerData {
@@ -118,12 +119,8 @@ impl Planner {
         rate: Option<f64>,
     ) -> Result<(Plan, bool, usize), PlanError> {
         check_inputs(f0, objective, requirements, settings)?;
+        self.check_joint_budgets(requirements)?;
         let arm = &self.arm;
-        let joints = arm.routing().joint_count();
-        if let Some(&(joint, _)) = requirements.joint_budgets.iter().find(|(j, _)| *j >= joints) {
-            let problem = InputProblem::NoSuchJoint { joint, joints };
-            return Err(PlanError::InvalidInput { what: "joint_budget", problem });
-        }
         self.check_fixed_levels(requirements)?;
         let sd = &mut data.stiffness;
         // The pose stage, once: geometry, T0, K_W and J_x at the pose.
@@ -309,40 +306,9 @@ impl Planner {
         };
         let c_x = Matrix6::from_fn(|r, col| 0.5 * (c[(r, col)] + c[(col, r)]));
         let k_fd = outcome.k_fd().map(|k| 0.5 * (k + k.transpose()));
-        let total: f64 = tensions.iter().sum();
-        // The objective in its maximised sense at the answer.
-        let maximised = match objective {
-            Objective::StiffnessAlong(u) => u.dot(&(k_fd.ok_or(PlanError::NoEndStiffness)? * u)),
-            Objective::ComplianceAlong(u) => -u.dot(&(c_x.fixed_view::<3, 3>(0, 0) * u)),
-            Objective::MinStiffness => {
-                k_fd.ok_or(PlanError::NoEndStiffness)?.symmetric_eigenvalues().min()
-            }
-            Objective::Volume => {
-                let l = k_fd.and_then(|k| k.cholesky()).ok_or(PlanError::NoEndStiffness)?.l();
-                2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>()
-            }
-            Objective::LeastTension => -total,
-        };
-        // The bound's own rounding: a few ulps of the value.
-        let gap = (upper - maximised).max(0.0) + 8.0 * f64::EPSILON * maximised.abs();
-        let value = match objective {
-            Objective::ComplianceAlong(_) | Objective::LeastTension => -maximised,
-            _ => maximised,
-        };
         let levels = arm.statics().levels_of(&sd.cables, &sd.statics, &tensions).ok();
-        Ok(Plan {
-            objective,
-            value,
-            gap,
-            total_tension: total,
-            lambda: lambda.to_vec(),
-            tensions,
-            levels,
-            k_fd,
-            c_x,
-            min_eigenvalue,
-            iterations,
-        })
+        let at = Evaluated { c_x, k_fd, min_eigenvalue };
+        plan_at(objective, (lambda, tensions), at, upper, iterations, levels)
     }
 
     /// Why no point meets the rows of a plan at the pose of `data`: an infeasible load (the
@@ -416,36 +382,22 @@ impl Planner {
             .collect())
     }
 
+    /// Per-joint budgets name joints that exist.
+    pub(crate) fn check_joint_budgets(&self, requirements: &Requirements) -> Result<(), PlanError> {
+        let joints = self.arm.routing().joint_count();
+        if let Some(&(joint, _)) = requirements.joint_budgets.iter().find(|(j, _)| *j >= joints) {
+            let problem = InputProblem::NoSuchJoint { joint, joints };
+            return Err(PlanError::InvalidInput { what: "joint_budget", problem });
+        }
+        Ok(())
+    }
+
     /// Each per-joint budget as `(cables of the joint, B)`.
-    fn joint_budget_rows(&self, requirements: &Requirements) -> Vec<(std::ops::Range<usize>, f64)> {
+    pub(crate) fn joint_budget_rows(
+        &self,
+        requirements: &Requirements,
+    ) -> Vec<(std::ops::Range<usize>, f64)> {
         let routing = self.arm.routing();
         requirements.joint_budgets.iter().map(|&(j, b)| (routing.cables_of_joint(j), b)).collect()
     }
-}
-
-/// The stability margin of the stable arm in `sd` (its last end stage), as
-/// [`sinew_stiffness::Outcome::margin`] defines it, the least eigenvalue of `sym(K_q + K_W)`,
-/// by Cholesky trials instead of an eigendecomposition ([`LeastEigen`]; no allocation once
-/// `margin` is sized; its last eigenvector starts the next plan's).
-fn stable_margin(
-    sd: &mut ArmStiffnessData,
-    (a, least): &mut (Vec<f64>, LeastEigen),
-) -> Result<f64, PlanError> {
-    let n = sd.k_q().nrows();
-    a.resize(n * n, 0.0);
-    let k_q = sd.k_q();
-    for (i, row) in a.chunks_exact_mut(n).enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v = k_q[(i, j)];
-        }
-    }
-    let k_w = sd.k_w();
-    for (i, row) in a.chunks_exact_mut(n).enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v += k_w[(i, j)];
-        }
-    }
-    crate::dense::symmetrise(a, n);
-    // Stable: λ_min > 0.
-    Ok(least.least(a, n, Some(0.0)).ok_or(StiffnessError::Eigen)?)
 }
