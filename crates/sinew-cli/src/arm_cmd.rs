@@ -92,7 +92,7 @@ struct EllipsoidOut {
 /// Run `sinew arm`.
 pub fn run(args: &ArmArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, args.no_gravity)?;
-    if let Some(friction) = requested(&args.friction, &loaded.routing)? {
+    if let Some(friction) = requested(args.friction.asked(), &loaded.routing)? {
         return run_with_friction(args, &loaded, friction);
     }
     let (robot, routing) = (&loaded.robot, &loaded.routing);

@@ -27,22 +27,24 @@ use crate::output::{
 /// A negative or non-finite `--friction`; `--history` with a slip regime; the stick regime
 /// asked for at μ = 0.
 pub fn requested(
-    args: &FrictionArgs,
+    (friction, regime, history): (Option<f64>, Option<Regime>, Option<HistoryArg>),
     routing: &Routing,
 ) -> Result<Option<(FrictionModel, FrictionRegime)>, CliError> {
     let mut model = FrictionModel::new(routing);
-    if let Some(mu) = args.friction {
+    if let Some(mu) = friction {
         model = model
             .with_friction_coefficient(mu)
             .map_err(|e| CliError::input(format!("--friction: {e}")))?;
     }
-    let history = match args.history {
+    let history_asked = history.is_some();
+    let history = match history {
         None | Some(HistoryArg::Pull) => History::Pull,
         Some(HistoryArg::Release) => History::Release,
         Some(HistoryArg::Equal) => History::Equal,
     };
-    let regime = match args.regime {
-        Some(Regime::Pull) | Some(Regime::Release) if args.history.is_some() => {
+    let stick_asked = regime == Some(Regime::Stick) || history_asked;
+    let regime = match regime {
+        Some(Regime::Pull) | Some(Regime::Release) if history_asked => {
             return Err(CliError::input("--history: applies to --regime stick only"));
         }
         Some(Regime::Pull) => FrictionRegime::Slip(Slip::Pull),
@@ -50,7 +52,6 @@ pub fn requested(
         Some(Regime::Stick) | None => FrictionRegime::Stick(history),
     };
     let frictionless = model.friction_coefficients().iter().all(|&mu| mu == 0.0);
-    let stick_asked = args.regime == Some(Regime::Stick) || args.history.is_some();
     match (frictionless, stick_asked) {
         (true, false) => Ok(None),
         (true, true) => Err(CliError::input(
@@ -286,11 +287,7 @@ pub fn run(
                 FrictionRegime::Slip(Slip::Release) => "release",
                 FrictionRegime::Stick(_) => "stick",
             },
-            history: history.map(|h| match h {
-                History::Pull => "pull",
-                History::Release => "release",
-                History::Equal => "equal",
-            }),
+            history: history.map(history_name),
         },
         cables: routing.cables().iter().map(|c| c.name.clone()).collect(),
         t0: data.statics.t0.clone(),
@@ -393,4 +390,13 @@ fn render(out: &ArmFrictionOut, routing: &Routing) -> String {
         s.push_str(&format!("note: {note}\n"));
     }
     s
+}
+
+/// `--history`'s word for a history.
+pub fn history_name(history: History) -> &'static str {
+    match history {
+        History::Pull => "pull",
+        History::Release => "release",
+        History::Equal => "equal",
+    }
 }

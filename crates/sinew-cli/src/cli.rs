@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::friction_args::FrictionArgs;
+use crate::friction_args::{FrictionArgs, PlanFrictionArgs};
 
 /// Stiffness of cable-driven hyper-redundant manipulators, from a robot folder.
 ///
@@ -395,6 +395,8 @@ pub struct PlanArgs {
     pub objective: PlanObjective,
     #[command(flatten)]
     pub options: PlanOptions,
+    #[command(flatten)]
+    pub friction: PlanFrictionArgs,
     /// Ignore gravity (zero gravity vector instead of robot.toml's).
     #[arg(long)]
     pub no_gravity: bool,

@@ -1,5 +1,6 @@
 //! The friction options of `sinew arm` (spec §9): `--friction`, `--regime`, `--history`,
-//! `--direction` (clap derive), flattened into `ArmArgs`.
+//! `--direction` (clap derive), flattened into `ArmArgs`; and those of `sinew plan`
+//! (`--friction`, `--regime`, `--history`: its `--direction` is the objective's).
 
 use clap::{Args, ValueEnum};
 
@@ -23,6 +24,39 @@ pub struct FrictionArgs {
     /// UX,UY,UZ (base frame, any non-zero length). Default: the force part of --wrench.
     #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
     pub direction: Option<String>,
+}
+
+impl FrictionArgs {
+    /// μ, the regime and the history asked for.
+    pub fn asked(&self) -> (Option<f64>, Option<Regime>, Option<HistoryArg>) {
+        (self.friction, self.regime, self.history)
+    }
+}
+
+/// Friction at the holes for `sinew plan` (spec §9): a plan in the stick regime after a
+/// history. Used when the routing file or `--friction` gives some cable μ > 0.
+#[derive(Debug, Args)]
+pub struct PlanFrictionArgs {
+    /// The friction coefficient μ ≥ 0 of every cable at every hole (overrides the routing
+    /// file's).
+    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
+    pub friction: Option<f64>,
+    /// The regime: stick (no hole slides; the default with friction). The slip regimes (pull,
+    /// release) are refused: their stiffness is not symmetric and the end stiffness not
+    /// concave in the tensions.
+    #[arg(long, value_enum)]
+    pub regime: Option<Regime>,
+    /// How the tensions of a sticking cable were left: by a pull (the default), a release, or
+    /// equal along each cable.
+    #[arg(long, value_enum)]
+    pub history: Option<HistoryArg>,
+}
+
+impl PlanFrictionArgs {
+    /// μ, the regime and the history asked for.
+    pub fn asked(&self) -> (Option<f64>, Option<Regime>, Option<HistoryArg>) {
+        (self.friction, self.regime, self.history)
+    }
 }
 
 /// `--regime`.

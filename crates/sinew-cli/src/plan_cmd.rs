@@ -4,8 +4,12 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 use serde::Serialize;
 use sinew::planner::{
     DEFAULT_GAP, DEFAULT_MARGIN, Objective, PlanSettings, Planner, PlannerData, Requirements,
+    StickPlanData,
 };
-use sinew::stiffness::ArmStiffness;
+use sinew::routing::{FrictionModel, Routing};
+use sinew::stiffness::{ArmStiffness, FrictionRegime, History};
+
+use crate::arm_friction::{history_name, requested};
 
 use crate::cli::{PlanArgs, PlanObjective, PlanOptions};
 use crate::error::{CliError, library_error};
@@ -47,6 +51,37 @@ struct PlanOut {
     min_eigenvalue: f64,
     stable: bool,
     iterations: usize,
+    /// The stick regime's model and history, when the plan has friction (absent without, so
+    /// that a frictionless plan's document is unchanged).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    friction: Option<PlanFriction>,
+}
+
+/// `friction` of a plan in the stick regime.
+#[derive(Debug, Serialize)]
+struct PlanFriction {
+    /// μ of each cable.
+    mu: Vec<f64>,
+    regime: &'static str,
+    history: &'static str,
+}
+
+/// The stick regime's plan, when friction is asked for (`None`: the frictionless plan).
+///
+/// # Errors
+/// A slip regime (not planned: its stiffness is not symmetric, the end stiffness not concave
+/// in the tensions); those of [`requested`].
+fn stick_requested(
+    args: &PlanArgs,
+    routing: &Routing,
+) -> Result<Option<(FrictionModel, History)>, CliError> {
+    match requested(args.friction.asked(), routing)? {
+        None => Ok(None),
+        Some((_, FrictionRegime::Slip(_))) => Err(CliError::input(
+            "--regime pull|release: a slip regime is not planned (its K_q is not symmetric and the end stiffness is not concave in the tensions); plan in --regime stick",
+        )),
+        Some((model, FrictionRegime::Stick(history))) => Ok(Some((model, history))),
+    }
 }
 
 /// `J:X` pairs, joints numbered from 1 on the command line, 0-based in the library.
@@ -170,9 +205,25 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let planner = Planner::new(arm);
     let mut data = PlannerData::new(&planner);
     let f0 = Vector6::from_column_slice(&wrench);
-    let plan = planner
-        .plan(&mut data, &q, &f0, objective, &requirements, &settings)
-        .map_err(library_error)?;
+    let friction = stick_requested(args, routing)?;
+    let plan = match &friction {
+        None => planner.plan(&mut data, &q, &f0, objective, &requirements, &settings),
+        Some((model, history)) => {
+            let mut stick = StickPlanData::new(&planner, model);
+            let stage = (model, *history);
+            planner.plan_in_stick(
+                &mut data,
+                &mut stick,
+                stage,
+                &q,
+                &f0,
+                objective,
+                &requirements,
+                &settings,
+            )
+        }
+    }
+    .map_err(library_error)?;
     let g = robot.gravity();
     let out = PlanOut {
         command: "plan",
@@ -203,6 +254,11 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         min_eigenvalue: plan.min_eigenvalue,
         stable: plan.min_eigenvalue > 0.0,
         iterations: plan.iterations,
+        friction: friction.map(|(model, history)| PlanFriction {
+            mu: model.friction_coefficients().to_vec(),
+            regime: "stick",
+            history: history_name(history),
+        }),
     };
     if args.common.json { print_json(&out) } else { emit(&render(&out)) }
 }
@@ -242,7 +298,16 @@ fn render(out: &PlanOut) -> String {
         asked.push_str(", K_fd ⪰ K_des");
     }
     s.push_str(&asked);
-    s.push_str("\n\n");
+    s.push('\n');
+    if let Some(f) = &out.friction {
+        s.push_str(&format!(
+            "  friction at the holes: {} after {}, μ = {}\n",
+            f.regime,
+            f.history,
+            Fmt::Fixed(3).list(&f.mu)
+        ));
+    }
+    s.push('\n');
     s.push_str(&format!(
         "Optimum: {} {} (certified: within {} of the true optimum; {} iterations)\n",
         Fmt::Sci(8).num(out.value),

@@ -10,6 +10,7 @@ use serde::Serialize;
 use sinew::planner::{Planner, PlannerData, RateLimit, Step};
 use sinew::stiffness::ArmStiffness;
 
+use crate::arm_friction::requested;
 use crate::cli::PlanArgs;
 use crate::error::{CliError, library_error};
 use crate::input::{load, one_number, to_radians, wrench};
@@ -103,6 +104,11 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let steps = read_steps(path, robot.dof(), args.deg, &f0)?;
     let PlanRequest { objective, requirements, settings, .. } =
         request("--objective", args.objective, &args.options)?;
+    if requested(args.friction.asked(), routing)?.is_some() {
+        return Err(CliError::input(
+            "--trajectory: plans without friction at the holes; plan in the stick regime one pose at a time (--q), or give --friction 0",
+        ));
+    }
     let rate = match (&args.rate, &args.dt) {
         (Some(rate), Some(dt)) => {
             Some(RateLimit { max_rate: one_number("--rate", rate)?, dt: one_number("--dt", dt)? })

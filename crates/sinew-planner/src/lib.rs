@@ -28,7 +28,9 @@
 //! [`PlanError::NonConservativeLoad`].
 //!
 //! [`Planner::plan_along`] re-plans along a trajectory, warm-started ([`Step`], [`RateLimit`],
-//! [`AlongStep`]).
+//! [`AlongStep`]). [`Planner::plan_in_stick`] plans with friction at the holes, in the stick
+//! regime after a history (spec §9: `K_stick` is affine in the actuator tensions and
+//! symmetric, so the same problem and certificate apply; [`StickPlanData`]).
 //!
 //! Model and workspace as elsewhere: [`Planner`] (the arm), [`PlannerData`] (reusable). The
 //! interior-point method sizes its buffers once per run and allocates nothing per iteration
