@@ -94,3 +94,28 @@ fn stick_stiffens_the_arm_only_below_its_load_limit() {
         }
     }
 }
+
+/// The planner's stick optimum along the load: certified, within the frictionless plan's total
+/// tension, far above the frictionless optimum (K_stick ⪰ K after equal tensions), and after
+/// equal tensions the same for every μ (μ only sets the bands' widths, not K_stick).
+#[test]
+fn the_stick_plans_beat_the_frictionless_plan_within_its_total_tension() {
+    let dir = cdhrm5::dir();
+    let robot = sinew::robot::load(&dir).unwrap();
+    let routing = sinew::routing::load(&dir, &robot).unwrap();
+    let routed =
+        sinew::routing::load(dir.join(sinew::routing::ROUTED_ROUTING_FILE), &robot).unwrap();
+    let plans = paper::e6(&robot, [("decoupled", &routing), ("routed", &routed)]).unwrap().plans;
+    assert_eq!(plans.len(), 2 * 3 * 2);
+    for p in &plans {
+        let case = format!("{} μ = {} {:?}", p.model, p.mu, p.history);
+        assert!(p.gap >= 0.0 && p.gap <= 2e-6 * p.stick, "{case}: gap {}", p.gap);
+        assert!(p.total <= p.budget * (1.0 + 1e-9), "{case}: {} > {}", p.total, p.budget);
+        assert!(p.stick > 10.0 * p.frictionless, "{case}: {} vs {}", p.stick, p.frictionless);
+        if p.history == History::Equal {
+            let first = plans.iter().find(|q| q.model == p.model && q.history == History::Equal);
+            let first = first.unwrap().stick;
+            assert!((p.stick - first).abs() <= 1e-6 * first, "{case}: {} vs {first}", p.stick);
+        }
+    }
+}

@@ -1,13 +1,15 @@
 //! E6 (beyond the paper, spec §9): friction at the holes on the paper's arm at E4's pose and
 //! load, decoupled and routed, for μ in [`E6_MU`]: the tension reaching the anchors, the dead
 //! band, `λ_min(K_fd)` and the stiffness along the load in every regime against the
-//! frictionless arm, the directional stiffness along ±(the load) after each history, and the
-//! stick load limit along it.
+//! frictionless arm, the directional stiffness along ±(the load) after each history, the
+//! stick load limit along it, and the planner's stick-regime optimum against the frictionless
+//! plan at the same total tension.
 
 use std::fmt::Write as _;
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
+use crate::planner::{Objective, PlanSettings, Planner, PlannerData, Requirements, StickPlanData};
 use crate::robot::Robot;
 use crate::routing::{FrictionModel, Routing, Slip};
 use crate::statics::TensionChoice;
@@ -57,11 +59,35 @@ pub struct E6Row {
     pub stick_limit: Option<[f64; 2]>,
 }
 
+/// One plan of E6: the stiffness along the load, planned in the stick regime after a history
+/// with the frictionless plan's total tension as its budget.
+#[derive(Debug, Clone, PartialEq)]
+pub struct E6Plan {
+    /// `decoupled` or `routed`.
+    pub model: String,
+    /// μ at every hole.
+    pub mu: f64,
+    /// The history the stick regime keeps.
+    pub history: History,
+    /// The frictionless plan's optimum `uᵀK_fd u`, N/m.
+    pub frictionless: f64,
+    /// Its total tension, N: the stick plan's budget.
+    pub budget: f64,
+    /// The stick plan's optimum, N/m.
+    pub stick: f64,
+    /// Its certified gap, N/m.
+    pub gap: f64,
+    /// Its total tension, N.
+    pub total: f64,
+}
+
 /// E6: every row, both models.
 #[derive(Debug, Clone, PartialEq)]
 pub struct E6 {
     /// Model by model: the frictionless rows, then μ by μ the regimes.
     pub rows: Vec<E6Row>,
+    /// Model by model, μ by μ: the stick plans after equal tensions and after a pull.
+    pub plans: Vec<E6Plan>,
 }
 
 /// The regimes of E6, in its order.
@@ -117,8 +143,10 @@ pub fn e6(robot: &Robot, routings: [(&str, &Routing); 2]) -> Result<E6, crate::E
     let u = Vector6::new(u3[0], u3[1], u3[2], 0.0, 0.0, 0.0);
     let levels = [E6_LEVEL; 5];
     let mut rows = Vec::new();
+    let mut plans = Vec::new();
     for (name, routing) in routings {
         let arm = ArmStiffness::new(robot, routing)?;
+        plans.extend(stick_plans(name, &arm, routing)?);
         let mut data = ArmStiffnessData::new(&arm);
         let choice = TensionChoice::Levels(&levels);
         arm.evaluate_joints(&mut data, &E4_Q, &f0, choice)?;
@@ -195,7 +223,53 @@ pub fn e6(robot: &Robot, routings: [(&str, &Routing); 2]) -> Result<E6, crate::E
             }
         }
     }
-    Ok(E6 { rows })
+    Ok(E6 { rows, plans })
+}
+
+/// The stiffness along E4's load, planned without friction, then in the stick regime after
+/// equal tensions and after a pull for each μ > 0 with the frictionless plan's total as budget.
+fn stick_plans(
+    name: &str,
+    arm: &ArmStiffness,
+    routing: &Routing,
+) -> Result<Vec<E6Plan>, crate::Error> {
+    let f0 = Vector6::from(E4_F0);
+    let u = Vector3::new(E4_F0[0], E4_F0[1], E4_F0[2]).normalize();
+    let objective = Objective::StiffnessAlong(u);
+    let planner = Planner::new(arm.clone());
+    let mut data = PlannerData::new(&planner);
+    let settings = PlanSettings::default();
+    let free =
+        planner.plan(&mut data, &E4_Q, &f0, objective, &Requirements::default(), &settings)?;
+    let requirements = Requirements { budget: Some(free.total_tension), ..Requirements::default() };
+    let mut out = Vec::new();
+    for &mu in E6_MU.iter().filter(|&&mu| mu > 0.0) {
+        let model = FrictionModel::new(routing).with_friction_coefficient(mu)?;
+        let mut stick = StickPlanData::new(&planner, &model);
+        for history in [History::Equal, History::Pull] {
+            let plan = planner.plan_in_stick(
+                &mut data,
+                &mut stick,
+                (&model, history),
+                &E4_Q,
+                &f0,
+                objective,
+                &requirements,
+                &settings,
+            )?;
+            out.push(E6Plan {
+                model: name.to_owned(),
+                mu,
+                history,
+                frictionless: free.value,
+                budget: free.total_tension,
+                stick: plan.value,
+                gap: plan.gap,
+                total: plan.total_tension,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// E6 as a markdown table, one row per model, μ and regime.
@@ -225,6 +299,30 @@ pub fn render_e6(e6: &E6) -> String {
             pair(r.directional, 3),
             r.sliding.map_or_else(|| "—".to_owned(), |[a, b]| format!("{a} / {b}")),
             pair(r.stick_limit, 4),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nThe planner's stiffness along the load (uᵀK_fd u) in the stick regime, with the frictionless plan's total tension as its budget:\n"
+    );
+    let _ = writeln!(
+        s,
+        "| model | μ | regime | frictionless plan (N/m) | budget = its Σ f (N) | stick plan (N/m) | gap (N/m) | its Σ f (N) | stick / frictionless |"
+    );
+    let _ = writeln!(s, "| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    for p in &e6.plans {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            p.model,
+            fixed(p.mu, 2),
+            regime_label(Some(FrictionRegime::Stick(p.history))),
+            fixed(p.frictionless, 3),
+            fixed(p.budget, 1),
+            fixed(p.stick, 1),
+            fixed(p.gap, 3),
+            fixed(p.total, 1),
+            fixed(p.stick / p.frictionless, 2),
         );
     }
     let joints = e6.rows.iter().map(|r| r.reaching.len()).max().unwrap_or(0);
@@ -304,9 +402,23 @@ pub fn e6_section(e6: &E6) -> String {
         r,
         "λ_min(K_fd) against μ, one line per regime, slip and stick apart (they differ by two orders of magnitude):\n\n![E6]({FIG_E6_FILE})\n"
     );
+    let ratio = |model: &str| {
+        let ratios: Vec<f64> = e6
+            .plans
+            .iter()
+            .filter(|p| p.model == model)
+            .map(|p| p.stick / p.frictionless)
+            .collect();
+        let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = (fixed(lo, 1), fixed(hi, 1));
+        if lo == hi { format!("{lo}×") } else { format!("{lo}–{hi}×") }
+    };
     let _ = writeln!(
         r,
-        "Not yet here: the planner's stick-regime optimum against the frictionless plan at the same total tension (the planner does not yet plan in stick)."
+        "**Planning in stick.** K_stick + K_W is affine in the actuator tensions and symmetric, so the planner certifies the stick regime's optimum as it does the frictionless one (`sinew plan --friction`). At the frictionless plan's total tension, the stiffest tensions along the load give {} (decoupled) and {} (routed) the frictionless optimum: the plan for an arm that holds its tensions is a different plan. A slip regime is not planned: its K is not symmetric and the end stiffness is not concave in the tensions.",
+        ratio("decoupled"),
+        ratio("routed"),
     );
     r
 }
