@@ -16,9 +16,9 @@ use sinew::stiffness::ArmStiffnessData;
 
 use crate::batch::BatchChoice;
 use crate::batch_out::evaluate_to_numpy;
-use crate::convert::{matrix, na2, vec1, vector, wrenches};
+use crate::convert::{matrix, vector, wrenches};
 use crate::errors::{input, library};
-use crate::friction::{FrictionArgs, evaluate_friction, requested};
+use crate::friction::{FrictionArgs, evaluate_friction, requested, stick_requested};
 use crate::lazy::LazyArray;
 use crate::model::{Robot, Routing};
 use crate::plan_along::along_result;
@@ -279,8 +279,10 @@ impl ArmStiffness {
     /// `"min-stiffness"`, `"volume"`, `"least-tension"`; requirements `k_min` (N/m), `k_des`
     /// (3 × 3, N/m), `margin` (N m/rad), `budget` (N), `joint_budgets` (`{joint: N}`,
     /// 0-based), `fixed_levels` (`{joint: level}`, 0-based, decoupled model); `gap` the
-    /// relative gap at which it stops. The GIL is released while it runs.
-    #[pyo3(signature = (q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, fixed_levels = None, gap = 1e-6))]
+    /// relative gap at which it stops. With friction at the holes (`friction` μ, `history`;
+    /// `regime` `"stick"`, the only one planned): the stick regime's plan
+    /// (`Planner::plan_in_stick`, as `sinew plan --friction`). The GIL is released while it runs.
+    #[pyo3(signature = (q, wrench = None, objective = "min-stiffness", direction = None, k_min = None, k_des = None, margin = 1e-3, budget = None, joint_budgets = None, fixed_levels = None, gap = 1e-6, friction = None, regime = None, history = None))]
     fn plan<'py>(
         &self,
         py: Python<'py>,
@@ -295,8 +297,13 @@ impl ArmStiffness {
         joint_budgets: Option<BTreeMap<usize, f64>>,
         fixed_levels: Option<BTreeMap<usize, f64>>,
         gap: f64,
+        friction: Option<f64>,
+        regime: Option<&str>,
+        history: Option<&str>,
     ) -> PyResult<PlanResult> {
         let arm = &self.arm;
+        let asked = FrictionArgs { mu: friction, regime, history, direction: None };
+        let stick = stick_requested(&asked, arm.routing())?;
         // The planner's pose stage refuses angles outside the limits.
         let q = vector(q, "q", Some(arm.dof()))?;
         let f0 = wrench_of(wrench)?;
@@ -323,23 +330,10 @@ impl ArmStiffness {
                         &mut fresh
                     }
                 };
-                planner.plan(data, &q, &f0, args.objective, &args.requirements, &args.settings)
+                args.plan((planner, data), stick.as_ref(), &q, &f0)
             })
             .map_err(library)?;
-        Ok(PlanResult {
-            objective: args.objective.name(),
-            value: plan.value,
-            gap: plan.gap,
-            lambda_: vec1(py, &plan.lambda).unbind(),
-            levels: plan.levels.as_ref().map(|l| vec1(py, l).unbind()),
-            tensions: vec1(py, &plan.tensions).unbind(),
-            total_tension: plan.total_tension,
-            k_fd: plan.k_fd.map(|k| na2(py, &k).unbind()),
-            c_x: na2(py, &plan.c_x).unbind(),
-            min_eigenvalue: plan.min_eigenvalue,
-            stable: plan.min_eigenvalue > 0.0,
-            iterations: plan.iterations,
-        })
+        Ok(PlanResult::new(py, &plan))
     }
 
     /// `plan` at every row of `Q` (N, dof) under `wrench` (one (6,) for every row, or (N, 6)),

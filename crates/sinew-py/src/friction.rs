@@ -31,6 +31,24 @@ pub struct FrictionArgs<'a, 'py> {
     pub direction: Option<&'a Bound<'py, PyAny>>,
 }
 
+/// The stick regime's model and history a plan asks for; `None` for the frictionless plan.
+///
+/// # Errors
+/// As [`requested`]; `InputError` for a slip regime (not planned: its `K_q` is not symmetric
+/// and the end stiffness is not concave in the tensions).
+pub fn stick_requested(
+    args: &FrictionArgs<'_, '_>,
+    routing: &Routing,
+) -> PyResult<Option<(FrictionModel, History)>> {
+    match requested(args, routing)? {
+        None => Ok(None),
+        Some((_, FrictionRegime::Slip(_))) => Err(input(
+            "regime: a slip regime is not planned (its K_q is not symmetric and the end stiffness is not concave in the tensions); plan with regime=\"stick\"",
+        )),
+        Some((model, FrictionRegime::Stick(history))) => Ok(Some((model, history))),
+    }
+}
+
 /// The friction model and regime the arguments and the routing file ask for; `None` for the
 /// frictionless path (every μ = 0 and neither `regime="stick"` nor `history` given).
 ///

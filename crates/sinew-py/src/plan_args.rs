@@ -3,9 +3,14 @@
 
 use std::collections::BTreeMap;
 
+use nalgebra::Vector6;
 use nalgebra::{Matrix3, Vector3};
 use pyo3::prelude::*;
-use sinew::planner::{Objective, PlanSettings, Requirements};
+use sinew::planner::{
+    Objective, Plan, PlanError, PlanSettings, Planner, PlannerData, Requirements, StickPlanData,
+};
+use sinew::routing::FrictionModel;
+use sinew::stiffness::History;
 
 use crate::convert::{finite, matrix, vector};
 use crate::errors::input;
@@ -80,4 +85,38 @@ pub fn plan_args(
     };
     let settings = PlanSettings { relative_gap: gap, ..PlanSettings::default() };
     Ok(PlanArgs { objective, requirements, settings })
+}
+
+impl PlanArgs {
+    /// The plan at `q` under `f0`: frictionless, or in the stick regime after a history.
+    ///
+    /// # Errors
+    /// The planner's.
+    pub fn plan(
+        &self,
+        (planner, data): (&Planner, &mut PlannerData),
+        stick: Option<&(FrictionModel, History)>,
+        q: &[f64],
+        f0: &Vector6<f64>,
+    ) -> Result<Plan, PlanError> {
+        let (objective, requirements, settings) =
+            (self.objective, &self.requirements, &self.settings);
+        match stick {
+            None => planner.plan(data, q, f0, objective, requirements, settings),
+            Some((model, history)) => {
+                let mut out = StickPlanData::new(planner, model);
+                let stage = (model, *history);
+                planner.plan_in_stick(
+                    data,
+                    &mut out,
+                    stage,
+                    q,
+                    f0,
+                    objective,
+                    requirements,
+                    settings,
+                )
+            }
+        }
+    }
 }

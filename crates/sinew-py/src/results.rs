@@ -315,6 +315,27 @@ pub struct PlanResult {
     pub(crate) iterations: usize,
 }
 
+impl PlanResult {
+    /// The Python result of a plan.
+    pub(crate) fn new(py: Python<'_>, plan: &sinew::planner::Plan) -> PlanResult {
+        use crate::convert::{na2, vec1};
+        PlanResult {
+            objective: plan.objective.name(),
+            value: plan.value,
+            gap: plan.gap,
+            lambda_: vec1(py, &plan.lambda).unbind(),
+            levels: plan.levels.as_ref().map(|l| vec1(py, l).unbind()),
+            tensions: vec1(py, &plan.tensions).unbind(),
+            total_tension: plan.total_tension,
+            k_fd: plan.k_fd.map(|k| na2(py, &k).unbind()),
+            c_x: na2(py, &plan.c_x).unbind(),
+            min_eigenvalue: plan.min_eigenvalue,
+            stable: plan.min_eigenvalue > 0.0,
+            iterations: plan.iterations,
+        }
+    }
+}
+
 #[pymethods]
 impl PlanResult {
     /// `λ` (a keyword in Python, hence also `lambda_`).

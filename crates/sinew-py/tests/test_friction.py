@@ -133,3 +133,32 @@ def test_require_stiffness_raises_in_a_regime_too(arm):
     assert not r.stable and r.c_x is None and r.k_fd is None
     with pytest.raises(sinew.UnstableError):
         arm.evaluate(E4_Q, E4_F0, levels=[0.0] * 5, friction=0.1, regime="pull", require_stiffness=True)
+
+
+@pytest.mark.parametrize("model", ["decoupled", "routed"])
+@pytest.mark.parametrize("history", ["pull", "equal"])
+def test_a_stick_plan_is_the_clis(robot, model, history):
+    arm = sinew.ArmStiffness(robot, sinew.load_routing(robot, model))
+    p = arm.plan(E4_Q, E4_F0, objective="stiffness-along", direction=[0, 1, 0],
+                 friction=0.1, history=history)
+    doc = cli("plan", "--robot", str(CDHRM5), "--model", model, "--q", csv(E4_Q),
+              "--wrench", csv(E4_F0), "--objective", "stiffness-along", "--direction", "0,1,0",
+              "--friction", "0.1", "--history", history)
+    assert doc["friction"] == {"mu": [0.1] * len(doc["cables"]), "regime": "stick", "history": history}
+    assert p.value == doc["value"] and p.gap == doc["gap"]
+    close(p.tensions, doc["tensions"])
+    assert p.min_eigenvalue == pytest.approx(doc["min_eigenvalue"], rel=1e-12)
+    free = arm.plan(E4_Q, E4_F0, objective="stiffness-along", direction=[0, 1, 0])
+    assert p.value > 10 * free.value
+    same = arm.plan(E4_Q, E4_F0, objective="stiffness-along", direction=[0, 1, 0], friction=0.0)
+    assert same.value == free.value
+    close(same.tensions, free.tensions)
+
+
+def test_a_slip_regime_is_not_planned(robot):
+    arm = sinew.ArmStiffness(robot, sinew.load_routing(robot, "decoupled"))
+    for regime in ("pull", "release"):
+        with pytest.raises(sinew.InputError, match="slip regime is not planned"):
+            arm.plan(E4_Q, E4_F0, friction=0.1, regime=regime)
+    with pytest.raises(sinew.InputError, match="μ > 0"):
+        arm.plan(E4_Q, E4_F0, regime="stick")

@@ -309,8 +309,13 @@ class ArmStiffness:
         joint_budgets: Optional[Mapping[int, float]] = None,
         fixed_levels: Optional[Mapping[int, float]] = None,
         gap: float = 1e-6,
+        friction: Optional[float] = None,
+        regime: Optional[Literal["stick", "pull", "release"]] = None,
+        history: Optional[Literal["pull", "release", "equal"]] = None,
     ) -> PlanResult:
-        """The tensions that optimise the end stiffness (``sinew plan``)."""
+        """The tensions that optimise the end stiffness (``sinew plan``); with ``friction``,
+        in the stick regime after ``history`` (``sinew plan --friction``; the slip regimes are
+        refused)."""
     def plan_many(
         self,
         Q: ArrayLike,
