@@ -311,7 +311,7 @@ pub struct PlanResult {
     pub(crate) min_eigenvalue: f64,
     /// Whether `min_eigenvalue > 0`.
     pub(crate) stable: bool,
-    /// Iterations of the bundle method.
+    /// Iterations of the method (interior point by default), all phases.
     pub(crate) iterations: usize,
 }
 
