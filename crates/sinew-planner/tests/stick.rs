@@ -278,3 +278,29 @@ fn what_the_stick_planner_does_not_offer_is_refused_by_name() {
     let PlanError::Stiffness(e) = &err else { panic!("{err}") };
     assert!(matches!(**e, StiffnessError::StickWithoutFriction { cable: 0 }), "{err}");
 }
+
+#[test]
+fn a_friction_model_or_workspace_of_another_arm_is_an_error_not_a_panic() {
+    let (planner, friction) = planner(PatternModel::Decoupled);
+    let (_, other) = cdhrm5::chain(3, PatternModel::Decoupled);
+    let foreign = FrictionModel::new(&other).with_friction_coefficient(MU).unwrap();
+    let mut data = PlannerData::new(&planner);
+    let q = cdhrm5::LOADED_POSE;
+    let settings = PlanSettings::default();
+    let requirements = Requirements::default();
+    let objective = Objective::MinStiffness;
+    // The model of another routing, with a workspace made for it.
+    let mut stick = StickPlanData::new(&planner, &foreign);
+    let stage = (&foreign, History::Pull);
+    let err = planner
+        .plan_in_stick(&mut data, &mut stick, stage, &q, &F0, objective, &requirements, &settings)
+        .unwrap_err();
+    assert!(matches!(err, PlanError::Routing(_) | PlanError::Stiffness(_)), "{err}");
+    // This arm's model with a workspace made for the other one.
+    let stage = (&friction, History::Equal);
+    let err = planner
+        .plan_in_stick(&mut data, &mut stick, stage, &q, &F0, objective, &requirements, &settings)
+        .unwrap_err();
+    assert!(matches!(err, PlanError::Routing(_) | PlanError::Stiffness(_)), "{err}");
+    eprintln!("{err}");
+}
