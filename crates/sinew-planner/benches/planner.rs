@@ -2,7 +2,7 @@
 //! pose under 5 N along y (both models, every objective, both methods), one pipeline evaluation
 //! of the same arm (the ratio is what carries to another machine), 100 warm-started steps along
 //! a 1 kHz trajectory, a 25-joint decoupled chain (50 DOF, weightless, 0.022 N at the tip) and a
-//! 100-joint one (200 DOF, 0.00045 N).
+//! 100-joint one (200 DOF, 0.00045 N), and plans in the stick regime (μ = 0.1).
 //! Prints each plan's iterations once, for the time per iteration.
 #![allow(missing_docs, clippy::unwrap_used)]
 
@@ -10,11 +10,13 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Vector3, Vector6};
-use sinew_planner::{Method, Objective, PlanSettings, Planner, PlannerData, Requirements, Step};
-use sinew_routing::PatternModel;
+use sinew_planner::{
+    Method, Objective, PlanSettings, Planner, PlannerData, Requirements, Step, StickPlanData,
+};
+use sinew_routing::{FrictionModel, PatternModel};
 use sinew_statics::TensionChoice;
-use sinew_stiffness::ArmStiffness;
 use sinew_stiffness::ArmStiffnessData;
+use sinew_stiffness::{ArmStiffness, History};
 use sinew_testkit::cdhrm5;
 
 fn objectives() -> [Objective; 5] {
@@ -76,6 +78,42 @@ fn bench_plans(c: &mut Criterion) {
                     })
                 });
             }
+        }
+    }
+    // In the stick regime (#27), μ = 0.1, after a pull and after equal tensions: the same
+    // problem on the stick pencil, the answer evaluated by the friction pipeline.
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        let friction = FrictionModel::new(&routing).with_friction_coefficient(0.1).unwrap();
+        let mut data = PlannerData::new(&planner);
+        let mut stick = StickPlanData::new(&planner, &friction);
+        let name = if model == PatternModel::Decoupled { "decoupled" } else { "routed" };
+        let q = cdhrm5::LOADED_POSE;
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        let objective = Objective::StiffnessAlong(Vector3::y());
+        let settings = PlanSettings::default();
+        for (history, label) in [(History::Pull, "pull"), (History::Equal, "equal")] {
+            let stage = (&friction, history);
+            group.bench_function(
+                format!("cdhrm5 {name} stick after {label} stiffness-along"),
+                |b| {
+                    b.iter(|| {
+                        planner
+                            .plan_in_stick(
+                                &mut data,
+                                &mut stick,
+                                stage,
+                                black_box(&q),
+                                &f0,
+                                objective,
+                                &requirements,
+                                &settings,
+                            )
+                            .unwrap()
+                    })
+                },
+            );
         }
     }
     // Re-planning along a smooth trajectory (1 kHz, joints at up to 3 rad/s): per step.
