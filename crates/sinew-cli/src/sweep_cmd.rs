@@ -58,6 +58,14 @@ struct GridOut {
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, false)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
+    if routing.has_friction() {
+        // Frictionless maps of an arm with friction would mislead: refuse, and say where it is
+        // modelled.
+        return Err(CliError::input(format!(
+            "{}: the routing gives friction at the holes (μ > 0), which sweep does not model yet; `sinew arm --friction` and `sinew plan --friction` do",
+            loaded.routing_file.display()
+        )));
+    }
     let i = joint(&args.joint, robot)?;
     let tau = numbers_n("--torque", &args.torque, 2, "torque components (T1,T2 in N m)")?;
     let points: usize = args.grid.trim().parse().map_err(|_| {
