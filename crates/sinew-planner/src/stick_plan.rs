@@ -17,9 +17,13 @@
 //! increments below the stick load limit ([`sinew_stiffness::stick_load_limit`]).
 
 use nalgebra::{Matrix6, Vector6};
-use sinew_routing::{FrictionModel, compute_capstan_weights, compute_friction_geometry};
-use sinew_statics::{TensionChoice, slip_equilibrium_set};
-use sinew_stiffness::{FrictionArmData, FrictionRegime, FrictionStiffnessData, History};
+use sinew_routing::{
+    FrictionData, FrictionModel, compute_capstan_weights, compute_friction_geometry,
+};
+use sinew_statics::{EquilibriumSet, TensionChoice, slip_equilibrium_set};
+use sinew_stiffness::{
+    ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, FrictionStiffnessData, History,
+};
 
 use crate::answer::{Evaluated, plan_at};
 use crate::error::{InputProblem, PlanError};
@@ -90,18 +94,8 @@ impl Planner {
         let arm = self.arm();
         let sd = &mut data.stiffness;
         arm.set_pose(sd, q, f0)?;
-        let routing = arm.routing();
         let friction = &mut stick.friction.friction;
-        compute_friction_geometry(model, routing, &sd.cables, friction)?;
-        let set = match history.slip() {
-            None => arm.equilibrium_set(sd)?.clone(),
-            Some(slip) => {
-                compute_capstan_weights(model, friction, slip)?;
-                let statics = arm.statics();
-                let (limits, groups) = (statics.cable_limits(), statics.joint_groups());
-                slip_equilibrium_set(model, friction, &sd.statics.t0, limits, groups)?
-            }
-        };
+        let set = stick_set(arm, sd, (model, history), friction)?;
         let mut pencil = data.pencil.take().unwrap_or_else(Pencil::empty);
         let stage = (model, &*friction, history);
         pencil.fill_stick(arm, sd, stage, &set, &mut stick.scratch)?;
@@ -147,13 +141,37 @@ impl Planner {
     }
 }
 
+/// At the pose of `sd`: the friction geometry (with the history's weights) into `friction`,
+/// and the equilibrium set of the history's statics (`J_c` after `equal`, `J̃` with the
+/// actuator limits after a pull or a release).
+///
+/// # Errors
+/// The friction geometry's; the statics'.
+pub(crate) fn stick_set(
+    arm: &ArmStiffness,
+    sd: &mut ArmStiffnessData,
+    (model, history): (&FrictionModel, History),
+    friction: &mut FrictionData,
+) -> Result<EquilibriumSet, PlanError> {
+    compute_friction_geometry(model, arm.routing(), &sd.cables, friction)?;
+    Ok(match history.slip() {
+        None => arm.equilibrium_set(sd)?.clone(),
+        Some(slip) => {
+            compute_capstan_weights(model, friction, slip)?;
+            let statics = arm.statics();
+            let (limits, groups) = (statics.cable_limits(), statics.joint_groups());
+            slip_equilibrium_set(model, friction, &sd.statics.t0, limits, groups)?
+        }
+    })
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use nalgebra::Vector6;
+    use sinew_routing::FrictionModel;
     use sinew_routing::PatternModel;
-    use sinew_routing::{FrictionModel, compute_capstan_weights, compute_friction_geometry};
-    use sinew_statics::{TensionChoice, TensionPolicy, slip_equilibrium_set};
+    use sinew_statics::{TensionChoice, TensionPolicy};
     use sinew_stiffness::{ArmStiffness, FrictionRegime, History};
     use sinew_testkit::cdhrm5;
 
@@ -180,16 +198,7 @@ mod tests {
                 let sd = &mut data.stiffness;
                 arm.set_pose(sd, &q, &f0).unwrap();
                 let fd = &mut stick.friction.friction;
-                compute_friction_geometry(&friction, arm.routing(), &sd.cables, fd).unwrap();
-                let set = match history.slip() {
-                    None => arm.equilibrium_set(sd).unwrap().clone(),
-                    Some(slip) => {
-                        compute_capstan_weights(&friction, fd, slip).unwrap();
-                        let statics = arm.statics();
-                        let (l, g) = (statics.cable_limits(), statics.joint_groups());
-                        slip_equilibrium_set(&friction, fd, &sd.statics.t0, l, g).unwrap()
-                    }
-                };
+                let set = super::stick_set(arm, sd, (&friction, history), fd).unwrap();
                 let mut pencil = Pencil::empty();
                 let stage = (&friction, &*fd, history);
                 pencil.fill_stick(arm, sd, stage, &set, &mut stick.scratch).unwrap();
