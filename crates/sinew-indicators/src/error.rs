@@ -100,10 +100,13 @@ impl IndicatorError {
         }
     }
 
-    /// Whether this is an infeasible load (the torque cannot be held within the limits).
+    /// Whether this is an infeasible load (the torque cannot be held within the limits; with
+    /// friction, also a cable whose segments no actuator tension keeps within them).
     pub fn is_infeasible(&self) -> bool {
         matches!(self, IndicatorError::Statics(e)
-            if matches!(**e, StaticsError::Infeasible { .. } | StaticsError::LevelsInfeasible(_)))
+            if matches!(**e, StaticsError::Infeasible { .. }
+                | StaticsError::LevelsInfeasible(_)
+                | StaticsError::EmptyActuatorInterval { .. }))
     }
 }
 

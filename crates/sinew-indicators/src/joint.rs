@@ -33,61 +33,13 @@ use std::ops::Range;
 use faer::Mat;
 use nalgebra::{Matrix2, Matrix3x2, Vector2};
 use sinew_robot::{Robot, RobotData};
-use sinew_routing::{Order, Routing, RoutingData, compute_cable_geometry};
-use sinew_statics::{TensionInterval, TensionLimits, tension_interval};
-use sinew_stiffness::{joint_block, joint_stiffness};
+use sinew_routing::{FrictionModel, Order, Routing, RoutingData, compute_cable_geometry};
+use sinew_statics::{TensionLimits, tension_interval};
+use sinew_stiffness::{FrictionRegime, joint_block, joint_stiffness};
 
 use crate::error::IndicatorError;
-
-/// The range of one stiffness component over the feasible tensions, and its width (eq. 20).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Indicator {
-    /// `[K^min, K^max]`, N m/rad.
-    pub range: [f64; 2],
-    /// `Δk = K^max − K^min`, N m/rad.
-    pub delta: f64,
-}
-
-impl Indicator {
-    fn from_ends(a: f64, b: f64) -> Indicator {
-        let range = [a.min(b), a.max(b)];
-        Indicator { range, delta: range[1] - range[0] }
-    }
-}
-
-/// One joint's stiffness over its feasible tension interval.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JointStiffnessRange {
-    /// The feasible tension interval.
-    pub interval: TensionInterval,
-    /// Joint stiffness at `λ_min` (least total tension), 2 × 2, N m/rad.
-    pub k_at_min: Matrix2<f64>,
-    /// Joint stiffness at `λ_max` (most total tension), 2 × 2, N m/rad.
-    pub k_at_max: Matrix2<f64>,
-    /// The controllable part at both ends (`Σ f_c H_c` over the joint's own three cables,
-    /// [`JointProbe::tensioned_cables`]), N m/rad.
-    pub controllable: [Matrix2<f64>; 2],
-    /// The inherent part (`J_cᵀ K_l J_c` over every cable crossing the joint,
-    /// [`JointProbe::inherent_cables`]; the same at both ends), N m/rad.
-    pub inherent: Matrix2<f64>,
-}
-
-impl JointStiffnessRange {
-    /// `σ_{i,x}`: the range of `K_{i,x}` and its width (eq. 20).
-    pub fn sigma_x(&self) -> Indicator {
-        Indicator::from_ends(self.k_at_min[(0, 0)], self.k_at_max[(0, 0)])
-    }
-
-    /// `σ_{i,y}`: the range of `K_{i,y}` and its width (eq. 20).
-    pub fn sigma_y(&self) -> Indicator {
-        Indicator::from_ends(self.k_at_min[(1, 1)], self.k_at_max[(1, 1)])
-    }
-
-    /// The joint stiffness at tension level `s ∈ [0, 1]` (affine in `λ`).
-    pub fn at_level(&self, s: f64) -> Matrix2<f64> {
-        self.k_at_min + s * (self.k_at_max - self.k_at_min)
-    }
-}
+use crate::probe_friction::ProbeFriction;
+use crate::range::JointStiffnessRange;
 
 /// A single joint of an arm, probed alone (Pinocchio-style model/data: this is the data, built
 /// once for a robot and routing, reused for every evaluation).
@@ -105,6 +57,8 @@ pub struct JointProbe {
     cables: RoutingData,
     controllable: Mat<f64>,
     inherent: Mat<f64>,
+    /// Friction at the holes ([`JointProbe::with_friction`]); `None`: the paper's model.
+    friction: Option<ProbeFriction>,
 }
 
 impl JointProbe {
@@ -155,7 +109,34 @@ impl JointProbe {
             cables: RoutingData::new(routing),
             controllable: Mat::zeros(n, n),
             inherent: Mat::zeros(n, n),
+            friction: None,
         })
+    }
+
+    /// The same probe with friction at the holes (spec §9): the friction `model` of the
+    /// routing (μ per cable) in `regime`. Its statics and joint stiffness are then the regime's
+    /// (the joint's three cables hold the torque through their segment tensions; in a slip
+    /// regime or after a pull or a release, the interval is that of their actuator tensions,
+    /// each within the actuator limits that keep every segment within the cable's limits).
+    /// With μ = 0 everywhere a slip regime gives the frictionless numbers bit for bit.
+    ///
+    /// # Errors
+    /// [`IndicatorError::Routing`] for a model of another routing;
+    /// [`IndicatorError::Stiffness`] for the stick regime with a cable at μ = 0 (no band to
+    /// stick in).
+    pub fn with_friction(
+        mut self,
+        routing: &Routing,
+        model: FrictionModel,
+        regime: FrictionRegime,
+    ) -> Result<JointProbe, IndicatorError> {
+        self.friction = Some(ProbeFriction::new(routing, model, regime)?);
+        Ok(self)
+    }
+
+    /// The friction model and regime of the probe, `None` for the paper's frictionless model.
+    pub fn friction(&self) -> Option<(&FrictionModel, FrictionRegime)> {
+        self.friction.as_ref().map(|f| (&f.model, f.regime))
     }
 
     /// The probed joint (0-based).
@@ -195,7 +176,8 @@ impl JointProbe {
     }
 
     /// The joint's stiffness over its feasible interval at angles `q` holding torque `tau`
-    /// (eq. 20, 22–23). No allocation.
+    /// (eq. 20, 22–23); with friction ([`JointProbe::with_friction`]), the regime's. No
+    /// allocation.
     ///
     /// # Errors
     /// Angles outside the joint limits ([`IndicatorError::Robot`]); an infeasible torque
@@ -219,15 +201,20 @@ impl JointProbe {
             &self.q,
             Order::Hessians,
         )?;
-        let j = self.cables.jacobian()?;
         let first = self.first_cable;
+        let tau = Vector2::new(tau[0], tau[1]);
+        if let Some(friction) = &mut self.friction {
+            let joint = (i, first);
+            return friction.evaluate(routing, &self.cables, joint, &tau, &mut self.tensions);
+        }
+        let j = self.cables.jacobian()?;
         let block = Matrix3x2::from_fn(|r, c| j[(first + r, 2 * i + c)]);
-        let interval = tension_interval(i, &block, &Vector2::new(tau[0], tau[1]), self.limits)?;
+        let interval = tension_interval(i, &block, &tau, self.limits)?;
         let mut ends = [Matrix2::zeros(); 2];
         let mut controllable = [Matrix2::zeros(); 2];
         let mut inherent = Matrix2::zeros();
-        for (end, lambda) in [interval.lambda_min, interval.lambda_max].into_iter().enumerate() {
-            let f = interval.tensions(lambda);
+        let (low, high) = interval.ends();
+        for (end, f) in [low, high].into_iter().enumerate() {
             self.tensions.fill(0.0);
             self.tensions[first..first + 3].copy_from_slice(f.as_slice());
             joint_stiffness(
@@ -247,6 +234,7 @@ impl JointProbe {
         }
         Ok(JointStiffnessRange {
             interval,
+            tensions: [low, high],
             k_at_min: ends[0],
             k_at_max: ends[1],
             controllable,

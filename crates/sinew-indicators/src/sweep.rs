@@ -9,7 +9,8 @@ use sinew_robot::Robot;
 use sinew_routing::Routing;
 
 use crate::error::IndicatorError;
-use crate::joint::{Indicator, JointProbe};
+use crate::joint::JointProbe;
+use crate::range::Indicator;
 
 /// A square grid of joint angles: `points` values from `lower` to `upper` on each axis, rad.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,18 +81,12 @@ impl SweepMaps {
     }
 }
 
-/// Sweep joint `joint`'s indicators over `grid × grid` for the torque `tau` (Fig. 5).
-///
-/// Parallel over the grid's rows; each thread reuses one [`JointProbe`]. After each row,
-/// `progress(done, total)` is called with the number of points done so far and the total
-/// (`points²`), from whichever thread finished the row (pass `&|_, _| {}` for none).
-/// Infeasible points are `None`; other errors (angles outside the limits, bad geometry) stop
-/// the sweep.
+/// Sweep joint `joint`'s indicators over `grid × grid` for the torque `tau` (Fig. 5), the
+/// other joints at zero: [`sweep_probe`] with [`JointProbe::new`]'s probe.
 ///
 /// # Errors
-/// [`IndicatorError::GridTooSmall`], [`IndicatorError::GridRange`],
-/// [`IndicatorError::NoSuchJoint`], [`IndicatorError::NotThreeCables`], and the first
-/// non-infeasibility error of a point.
+/// [`IndicatorError::NoSuchJoint`], [`IndicatorError::NotThreeCables`],
+/// [`IndicatorError::NotUniversal`], and those of [`sweep_probe`].
 pub fn sweep_joint(
     robot: &Robot,
     routing: &Routing,
@@ -101,8 +96,31 @@ pub fn sweep_joint(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<SweepMaps, IndicatorError> {
     grid.check()?;
-    let probe = JointProbe::new(robot, routing, joint)?;
-    let n = grid.points;
+    sweep_probe(&JointProbe::new(robot, routing, joint)?, robot, routing, tau, grid, progress)
+}
+
+/// Sweep the indicators of `probe`'s joint over `grid × grid` for the torque `tau` (Fig. 5),
+/// with the probe's other joint angles and friction ([`JointProbe::with_friction`]).
+///
+/// Parallel over the grid's rows; each thread reuses a clone of `probe`. After each row,
+/// `progress(done, total)` is called with the number of points done so far and the total
+/// (`points²`), from whichever thread finished the row (pass `&|_, _| {}` for none).
+/// Infeasible points are `None`; other errors (angles outside the limits, bad geometry) stop
+/// the sweep.
+///
+/// # Errors
+/// [`IndicatorError::GridTooSmall`], [`IndicatorError::GridRange`], and the first
+/// non-infeasibility error of a point.
+pub fn sweep_probe(
+    probe: &JointProbe,
+    robot: &Robot,
+    routing: &Routing,
+    tau: [f64; 2],
+    grid: AngleGrid,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<SweepMaps, IndicatorError> {
+    grid.check()?;
+    let (joint, n) = (probe.joint(), grid.points);
     let done = AtomicUsize::new(0);
     let rows: Result<Vec<Vec<Option<SweepCell>>>, IndicatorError> = (0..n)
         .into_par_iter()

@@ -9,8 +9,9 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 use sinew_indicators::{JointProbe, StiffnessEllipsoid};
+use sinew_routing::{FrictionModel, Slip};
 use sinew_statics::TensionChoice;
-use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, FrictionRegime, History};
 use sinew_testkit::alloc::{CountingAllocator, assert_counting, count};
 use sinew_testkit::{cdhrm5, config};
 
@@ -23,6 +24,7 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 fn evaluating_the_indicators_allocates_nothing() {
     assert_counting();
     probe_evaluations_allocate_nothing();
+    probes_with_friction_allocate_nothing();
     an_infeasible_probe_allocates_only_its_boxed_error();
     the_ellipsoid_allocates_nothing();
 }
@@ -59,6 +61,39 @@ fn probe_evaluations_allocate_nothing() {
                 "{name}, joint {}: {allocations} allocations in 10 probe evaluations ({feasible} feasible)",
                 joint + 1
             );
+        }
+    }
+}
+
+fn probes_with_friction_allocate_nothing() {
+    // Every regime (the friction geometry, the capstan weights, the actuator interval, the
+    // regime's joint stiffness): the workspaces are the probe's.
+    let regimes = [
+        FrictionRegime::Slip(Slip::Pull),
+        FrictionRegime::Slip(Slip::Release),
+        FrictionRegime::Stick(History::Pull),
+        FrictionRegime::Stick(History::Equal),
+    ];
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let friction = FrictionModel::new(&routing).with_friction_coefficient(0.1).unwrap();
+        let qs = config::random_qs(&robot, 6, 10);
+        for regime in regimes {
+            let probe = JointProbe::new(&robot, &routing, 3).unwrap();
+            let mut probe = probe.with_friction(&routing, friction.clone(), regime).unwrap();
+            let tau = [-1.0, 0.5];
+            probe.evaluate(&robot, &routing, [0.1, -0.1], tau).unwrap();
+            let (allocations, feasible) = count(|| {
+                let mut feasible = 0;
+                for q in &qs {
+                    probe.set_configuration(q).unwrap();
+                    let angles = [q[6], q[7]];
+                    feasible += usize::from(probe.evaluate(&robot, &routing, angles, tau).is_ok());
+                }
+                feasible
+            });
+            assert!(feasible > 0);
+            assert_eq!(allocations, 0, "{model:?}, {regime:?}: {allocations} allocations");
         }
     }
 }

@@ -56,6 +56,7 @@
 //! The interior-point solves use clarabel's default tolerances ([`convex`]).
 #![deny(missing_docs)]
 
+mod actuator_interval;
 mod arm;
 mod choice;
 pub mod convex;
@@ -71,6 +72,7 @@ mod set_block;
 mod slip;
 mod three_cable;
 
+pub use actuator_interval::{ActuatorInterval, actuator_interval};
 pub use arm::{ArmStatics, ArmStaticsData, check_balance};
 pub use choice::{Chosen, DEFAULT_POLICY_NOTE, TensionChoice};
 pub use distribution::{CableLayout, distribute_tensions};
@@ -86,7 +88,10 @@ pub use joint_end::{
 pub use policy::{Distribution, TensionPolicy, distribute_with_policy};
 pub use refusal::{InfeasibleReason, LevelsInfeasible, NotBalanced};
 pub use set_block::SET_RANK_TOLERANCE;
-pub use slip::{actuator_limits, dead_band, slip_equilibrium_set, slip_levels, slip_torques};
+pub use slip::{
+    actuator_limits, cable_actuator_limits, dead_band, slip_equilibrium_set, slip_levels,
+    slip_torques,
+};
 
 use faer::MatRef;
 

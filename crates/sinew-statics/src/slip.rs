@@ -37,6 +37,7 @@ use sinew_routing::{FrictionData, FrictionModel};
 use faer::Mat;
 use nalgebra::Vector3;
 
+use crate::actuator_interval::limit_scaling;
 use crate::distribution::{CableLayout, distribute_tensions};
 use crate::equilibrium::EquilibriumSet;
 use crate::error::StaticsError;
@@ -78,21 +79,33 @@ pub fn actuator_limits(
         ("segment tension limits", m, segment_limits.len()),
         ("actuator limits", m, out.len()),
     ])?;
-    for (c, (limits, out)) in segment_limits.iter().zip(out.iter_mut()).enumerate() {
-        let weights = data.weights(model, c)?;
-        let (lo, hi) =
-            weights.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &w| (lo.min(w), hi.max(w)));
-        let interval = [limits[0] / lo, limits[1] / hi];
-        if interval[0] > interval[1] {
-            return Err(StaticsError::EmptyActuatorInterval {
-                cable: c,
-                limits: *limits,
-                ratio: hi / lo,
-            });
-        }
-        *out = interval;
+    for (c, (&limits, out)) in segment_limits.iter().zip(out.iter_mut()).enumerate() {
+        *out = cable_actuator_limits(model, data, c, limits)?;
     }
     Ok(())
+}
+
+/// Cable `c`'s actuator-tension limits in the slip regime whose weights `data` holds,
+/// `[f_min / min_s w_s, f_max / max_s w_s]` for its segment limits `limits = [f_min, f_max]`
+/// (N): one cable of [`actuator_limits`]. No allocation.
+///
+/// # Errors
+/// [`StaticsError::Routing`] before the weights or for a cable out of range;
+/// [`StaticsError::EmptyActuatorInterval`].
+pub fn cable_actuator_limits(
+    model: &FrictionModel,
+    data: &FrictionData,
+    c: usize,
+    limits: [f64; 2],
+) -> Result<[f64; 2], StaticsError> {
+    let weights = data.weights(model, c)?;
+    let (lo, hi) =
+        weights.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &w| (lo.min(w), hi.max(w)));
+    let interval = [limits[0] / lo, limits[1] / hi];
+    if interval[0] > interval[1] {
+        return Err(StaticsError::EmptyActuatorInterval { cable: c, limits, ratio: hi / lo });
+    }
+    Ok(interval)
 }
 
 /// The dead band of every cable (spec §9): for the anchor tensions `anchor` (m, N), the
@@ -156,11 +169,9 @@ pub fn slip_equilibrium_set(
 /// rounding. Allocates (a scaled copy of `J̃`).
 ///
 /// # Math
-/// The cables' actuator intervals `[a_c, b_c]` differ, the closed form's limits are common.
-/// With `T_c = α_c g_c + β_c`, `α_c = (b_c − a_c)/(f_max − f_min)`, `β_c = a_c − α_c f_min`,
-/// `T_c ∈ [a_c, b_c] ⇔ g_c ∈ [f_min, f_max]`, and `t0 + J̃ᵀ T = 0 ⇔ t0' + (J̃ D)ᵀ g = 0` with
-/// `D = diag α`, `t0' = t0 + J̃ᵀ β`: the closed form on `(J̃ D, t0')` with the limits
-/// `[f_min, f_max]` gives `g`. An affine map keeps a segment's ends and its fractions, so
+/// The cables' actuator intervals `[a_c, b_c]` differ, the closed form's limits are common:
+/// the closed form on the scaled `(J̃ D, t0 + J̃ᵀ β)` with the limits `[f_min, f_max]` gives
+/// `g`, and `T_c = α_c g_c + β_c` (the map of [`crate::ActuatorInterval`]). An affine map keeps a segment's ends and its fractions, so
 /// level `s` of `g`'s interval is level `s` of `T`'s, up to the direction: the closed form
 /// orients a joint's null direction `n` by `Σ n ≥ 0`; where `Σ α n < 0` (no force closure) the
 /// level is mirrored, `1 − s`, so that level 0 stays the least total actuator tension.
@@ -186,10 +197,8 @@ pub fn slip_levels(
     let j_tilde = data.effective_jacobian()?;
     let dof = j_tilde.ncols();
     sizes(&[("equilibrium torques T0", dof, t0.len())])?;
-    let span = limits.f_max - limits.f_min;
-    let alpha: Vec<f64> = actuator.iter().map(|[a, b]| (b - a) / span).collect();
-    let beta: Vec<f64> =
-        actuator.iter().zip(&alpha).map(|([a, _], s)| a - s * limits.f_min).collect();
+    let (alpha, beta): (Vec<f64>, Vec<f64>) =
+        actuator.iter().map(|&a| limit_scaling(a, limits)).unzip();
     let scaled = Mat::from_fn(m, dof, |c, k| j_tilde[(c, k)] * alpha[c]);
     let shifted: Vec<f64> = t0
         .iter()
