@@ -94,13 +94,37 @@ struct ArmFrictionOut {
     notes: Vec<String>,
 }
 
+/// `friction` of `sinew arm` and `sinew sweep`: μ per cable, the regime and its history.
 #[derive(Debug, Serialize)]
-struct FrictionOut {
+pub struct FrictionOut {
     /// Per cable.
-    mu: Vec<f64>,
-    regime: &'static str,
+    pub mu: Vec<f64>,
+    /// `pull`, `release` or `stick`.
+    pub regime: &'static str,
     /// The stick regime's history (null in a slip regime).
-    history: Option<&'static str>,
+    pub history: Option<&'static str>,
+}
+
+impl FrictionOut {
+    /// The document's `friction` for `model` in `regime`.
+    pub fn new(model: &FrictionModel, regime: FrictionRegime) -> FrictionOut {
+        let (regime, history) = match regime {
+            FrictionRegime::Slip(Slip::Pull) => ("pull", None),
+            FrictionRegime::Slip(Slip::Release) => ("release", None),
+            FrictionRegime::Stick(history) => ("stick", Some(history_name(history))),
+        };
+        FrictionOut { mu: model.friction_coefficients().to_vec(), regime, history }
+    }
+
+    /// One line of text: `regime stick (history: pull), μ = …`.
+    pub fn describe(&self) -> String {
+        format!(
+            "regime {}{}, μ = {}",
+            self.regime,
+            self.history.map(|h| format!(" (history: {h})")).unwrap_or_default(),
+            Fmt::Fixed(3).list(&self.mu)
+        )
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -280,15 +304,7 @@ pub fn run(
         gravity: [g.x, g.y, g.z],
         q,
         wrench,
-        friction: FrictionOut {
-            mu: model.friction_coefficients().to_vec(),
-            regime: match regime {
-                FrictionRegime::Slip(Slip::Pull) => "pull",
-                FrictionRegime::Slip(Slip::Release) => "release",
-                FrictionRegime::Stick(_) => "stick",
-            },
-            history: history.map(history_name),
-        },
+        friction: FrictionOut::new(&model, regime),
         cables: routing.cables().iter().map(|c| c.name.clone()).collect(),
         t0: data.statics.t0.clone(),
         tensions: out.actuator.clone(),
@@ -312,13 +328,11 @@ pub fn run(
 
 fn render(out: &ArmFrictionOut, routing: &Routing) -> String {
     let mut s = format!(
-        "arm `{}` ({}: {}) with friction: regime {}{}, μ = {}\n",
+        "arm `{}` ({}: {}) with friction: {}\n",
         out.robot,
         out.model,
         out.routing_file,
-        out.friction.regime,
-        out.friction.history.map(|h| format!(" (history: {h})")).unwrap_or_default(),
-        Fmt::Fixed(3).list(&out.friction.mu),
+        out.friction.describe(),
     );
     s.push_str(&format!("  Q  = {} rad\n", Fmt::Fixed(5).list(&out.q)));
     s.push_str(&format!("  F0 = {} (N, N m)\n\n", Fmt::Fixed(4).list(&out.wrench)));

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::friction_args::{FrictionArgs, PlanFrictionArgs};
+use crate::friction_args::{FrictionArgs, PlanFrictionArgs, RegimeArgs};
 
 /// Stiffness of cable-driven hyper-redundant manipulators, from a robot folder.
 ///
@@ -425,4 +425,8 @@ pub struct SweepArgs {
     /// where infeasible) to FILE; the tables are then replaced by a summary.
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
+    /// Friction at the holes (spec §9): the regime's statics (actuator tensions) and joint
+    /// stiffness.
+    #[command(flatten)]
+    pub friction: RegimeArgs,
 }

@@ -1,13 +1,14 @@
-//! The friction options of `sinew arm` (spec §9): `--friction`, `--regime`, `--history`,
-//! `--direction` (clap derive), flattened into `ArmArgs`; and those of `sinew plan`
-//! (`--friction`, `--regime`, `--history`: its `--direction` is the objective's).
+//! The friction options (spec §9, clap derive): `--friction`, `--regime`, `--history` of `sinew
+//! arm` and `sinew sweep`, with `--direction` for `sinew arm`; and those of `sinew plan` (the
+//! same three, stick only: its `--direction` is the objective's).
 
 use clap::{Args, ValueEnum};
 
-/// Friction at the holes (spec §9): used when the routing file or `--friction` gives some
-/// cable μ > 0; with μ = 0 everywhere the frictionless model, exactly.
+/// Friction at the holes (spec §9): `--friction`, `--regime`, `--history`, shared by `sinew
+/// arm` and `sinew sweep`. Used when the routing file or `--friction` gives some cable μ > 0;
+/// with μ = 0 everywhere the frictionless model, exactly.
 #[derive(Debug, Args)]
-pub struct FrictionArgs {
+pub struct RegimeArgs {
     /// The friction coefficient μ ≥ 0 of every cable at every hole (overrides the routing
     /// file's).
     #[arg(long, value_name = "MU", allow_hyphen_values = true)]
@@ -20,6 +21,22 @@ pub struct FrictionArgs {
     /// equal along each cable.
     #[arg(long, value_enum)]
     pub history: Option<HistoryArg>,
+}
+
+impl RegimeArgs {
+    /// μ, the regime and the history asked for.
+    pub fn asked(&self) -> (Option<f64>, Option<Regime>, Option<HistoryArg>) {
+        (self.friction, self.regime, self.history)
+    }
+}
+
+/// The friction options of `sinew arm` (spec §9): [`RegimeArgs`] and the direction of the
+/// directional response.
+#[derive(Debug, Args)]
+pub struct FrictionArgs {
+    /// `--friction`, `--regime`, `--history`.
+    #[command(flatten)]
+    pub regime: RegimeArgs,
     /// The force direction of the directional response and of one more stick load limit:
     /// UX,UY,UZ (base frame, any non-zero length). Default: the force part of --wrench.
     #[arg(long, value_name = "UX,UY,UZ", allow_hyphen_values = true)]
@@ -29,7 +46,7 @@ pub struct FrictionArgs {
 impl FrictionArgs {
     /// μ, the regime and the history asked for.
     pub fn asked(&self) -> (Option<f64>, Option<Regime>, Option<HistoryArg>) {
-        (self.friction, self.regime, self.history)
+        self.regime.asked()
     }
 }
 

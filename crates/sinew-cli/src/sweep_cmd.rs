@@ -4,9 +4,10 @@ use std::io::Write;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
-use sinew::indicators::{AngleGrid, JointProbe, SweepCell, SweepMaps, sweep_joint};
+use sinew::indicators::{AngleGrid, JointProbe, SweepCell, SweepMaps, sweep_probe};
 use sinew::robot::Compact;
 
+use crate::arm_friction::{FrictionOut, requested};
 use crate::cli::SweepArgs;
 use crate::error::{CliError, library_error};
 use crate::input::{joint, load, numbers_n};
@@ -43,6 +44,10 @@ struct SweepOut {
     k_y_max: Vec<Vec<Option<f64>>>,
     /// The CSV file written, if any.
     csv: Option<String>,
+    /// Friction at the holes (spec §9), when modelled (absent without, so that a frictionless
+    /// sweep's document is unchanged): the regime's actuator tensions and joint stiffness.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    friction: Option<FrictionOut>,
 }
 
 /// The angle grid, the same on both axes.
@@ -58,14 +63,8 @@ struct GridOut {
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let loaded = load(&args.common.robot, args.common.model, false)?;
     let (robot, routing) = (&loaded.robot, &loaded.routing);
-    if routing.has_friction() {
-        // Frictionless maps of an arm with friction would mislead: refuse, and say where it is
-        // modelled.
-        return Err(CliError::input(format!(
-            "{}: the routing gives friction at the holes (μ > 0), which sweep does not model yet; `sinew arm --friction` and `sinew plan --friction` do",
-            loaded.routing_file.display()
-        )));
-    }
+    // Friction at the holes when the routing file or --friction gives some μ > 0 (spec §9).
+    let friction = requested(args.friction.asked(), routing)?;
     let i = joint(&args.joint, robot)?;
     let tau = numbers_n("--torque", &args.torque, 2, "torque components (T1,T2 in N m)")?;
     let points: usize = args.grid.trim().parse().map_err(|_| {
@@ -79,7 +78,10 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     }
     // The library says whether the robot has this joint (and whether it has three cables);
     // too few points and an empty range are its to refuse too.
-    JointProbe::new(robot, routing, i).map_err(library_error)?;
+    let mut probe = JointProbe::new(robot, routing, i).map_err(library_error)?;
+    if let Some((model, regime)) = &friction {
+        probe = probe.with_friction(routing, model.clone(), *regime).map_err(library_error)?;
+    }
     // Both axes share one grid: the range the joint's first and second axes both allow.
     let (jx, jy) = (&robot.joints()[2 * i], &robot.joints()[2 * i + 1]);
     let (lower, upper) = (jx.lower.max(jy.lower), jx.upper.min(jy.upper));
@@ -93,7 +95,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         None => None,
     };
     let bar = progress_bar(points.saturating_mul(points));
-    let maps = sweep_joint(robot, routing, i, [tau[0], tau[1]], grid, &|done, _| {
+    let maps = sweep_probe(&probe, robot, routing, [tau[0], tau[1]], grid, &|done, _| {
         bar.set_position(done as u64)
     });
     bar.finish_and_clear();
@@ -126,6 +128,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         k_y_min: map(|c| c.k_y.range[0]),
         k_y_max: map(|c| c.k_y.range[1]),
         csv: args.out.as_ref().map(|p| p.display().to_string()),
+        friction: friction.map(|(model, regime)| FrictionOut::new(&model, regime)),
     };
     if args.common.json { print_json(&out) } else { emit(&render(&out, &maps, args.out.is_none())) }
 }
@@ -151,6 +154,14 @@ fn render(out: &SweepOut, maps: &SweepMaps, with_maps: bool) -> String {
         out.model,
         out.routing_file
     ));
+    if let Some(f) = &out.friction {
+        s.push_str(&format!(
+            "  friction at the holes: {}; tensions are actuator tensions, each within the limits that keep every segment in [{}, {}] N\n",
+            f.describe(),
+            out.tension_limits[0],
+            out.tension_limits[1]
+        ));
+    }
     s.push_str(&format!(
         "  torque = {} N m, tensions in [{}, {}] N\n  grid: {n} × {n} points, q1 and q2 from {} to {} rad\n  feasible: {} of {} points\n",
         Fmt::Fixed(4).list(&out.torque),

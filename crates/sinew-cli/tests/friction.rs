@@ -159,35 +159,3 @@ fn bad_input_is_one_line_and_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--direction: required"));
 }
-
-/// `sinew sweep` does not model friction yet: a routing with μ > 0 is refused in one line
-/// naming the file and where friction is modelled (exit 2, nothing written), not mapped as if
-/// frictionless.
-#[test]
-fn sweep_refuses_a_routing_with_friction() {
-    let dir = std::env::temp_dir().join(format!("sinew-sweep-friction-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    for entry in std::fs::read_dir(cdhrm5::dir()).unwrap() {
-        let path = entry.unwrap().path();
-        std::fs::copy(&path, dir.join(path.file_name().unwrap())).unwrap();
-    }
-    let cables = dir.join("cables.toml");
-    let text = std::fs::read_to_string(&cables).unwrap();
-    let sweep = |dir: &std::path::Path| {
-        let args = ["sweep", "--robot", dir.to_str().unwrap(), "--joint", "1"];
-        let extra = ["--torque", "0.3,0.3", "--grid", "3", "--json"];
-        Command::new(env!("CARGO_BIN_EXE_sinew")).args(args).args(extra).output().unwrap()
-    };
-    // μ = 0 given explicitly: the sweep runs.
-    std::fs::write(&cables, format!("friction_coefficient = 0.0\n{text}")).unwrap();
-    assert!(sweep(&dir).status.success());
-    std::fs::write(&cables, format!("friction_coefficient = 0.1\n{text}")).unwrap();
-    let out = sweep(&dir);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(out.stdout.is_empty());
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("cables.toml") && stderr.contains("sinew arm --friction"), "{stderr}");
-    std::fs::remove_dir_all(&dir).unwrap();
-}

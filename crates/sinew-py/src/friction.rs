@@ -225,7 +225,8 @@ fn force_direction(
     Ok(Some(Vector6::new(u[0], u[1], u[2], 0.0, 0.0, 0.0)))
 }
 
-fn name(regime: FrictionRegime) -> (&'static str, Option<&'static str>) {
+/// The regime's name and, in stick, its history's (`"pull"`, `"release"`, `"stick"`; …).
+pub fn name(regime: FrictionRegime) -> (&'static str, Option<&'static str>) {
     match regime {
         FrictionRegime::Slip(Slip::Pull) => ("pull", None),
         FrictionRegime::Slip(Slip::Release) => ("release", None),

@@ -3,10 +3,11 @@
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use sinew::indicators::{AngleGrid, JointProbe, sweep_joint};
+use sinew::indicators::{AngleGrid, JointProbe, sweep_probe};
 
 use crate::convert::{na2, vec1, vec2, vector};
 use crate::errors::{input, library};
+use crate::friction::{FrictionArgs, name, requested};
 use crate::model::{Robot, Routing};
 use crate::pool::{run, threads_arg};
 
@@ -81,6 +82,12 @@ pub struct SweepResult {
     k_y_min: Py<PyArray2<f64>>,
     /// (points, points).
     k_y_max: Py<PyArray2<f64>>,
+    /// With friction at the holes: `"pull"`, `"release"` or `"stick"`; `None` without.
+    regime: Option<&'static str>,
+    /// The stick regime's history (`"pull"`, `"release"`, `"equal"`), else `None`.
+    history: Option<&'static str>,
+    /// μ of each cable with friction (m,), `None` without.
+    mu: Option<Py<PyArray1<f64>>>,
 }
 
 fn torque_of(torque: &Bound<'_, PyAny>) -> PyResult<[f64; 2]> {
@@ -105,7 +112,7 @@ pub fn joint_range(
     let tau = torque_of(torque)?;
     let range = probe.evaluate(r, c, [qv[0], qv[1]], tau).map_err(library)?;
     let iv = &range.interval;
-    let (lo, hi) = iv.ends();
+    let [lo, hi] = range.tensions;
     let cables = probe.tensioned_cables().map(|k| c.cables()[k].name.clone()).collect();
     let tensions: Vec<f64> = lo.iter().chain(hi.iter()).copied().collect();
     let (sx, sy) = (range.sigma_x(), range.sigma_y());
@@ -132,9 +139,12 @@ pub fn joint_range(
 /// The maps of joint `joint` (0-based) over a `points × points` grid of its two angles under
 /// `torque` (Fig. 5; `sinew sweep`), in parallel with the GIL released. The grid spans the
 /// range both of the joint's axes allow, unless `lower`/`upper` (rad) narrow it. On `threads`
-/// threads (a pool of its own), or every core (rayon's global pool) without.
+/// threads (a pool of its own), or every core (rayon's global pool) without. With friction at
+/// the holes (`friction` μ, `regime`, `history`, or μ from the routing file: spec §9), the
+/// regime's statics (actuator tensions) and joint stiffness, as `sinew sweep --friction`.
 #[pyfunction]
-#[pyo3(signature = (robot, routing, joint, torque, points = 41, lower = None, upper = None, threads = None))]
+#[pyo3(signature = (robot, routing, joint, torque, points = 41, lower = None, upper = None, threads = None, friction = None, regime = None, history = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn sweep(
     py: Python<'_>,
     robot: &Robot,
@@ -145,16 +155,29 @@ pub fn sweep(
     lower: Option<f64>,
     upper: Option<f64>,
     threads: Option<i64>,
+    friction: Option<f64>,
+    regime: Option<&str>,
+    history: Option<&str>,
 ) -> PyResult<SweepResult> {
     let threads = threads_arg(threads)?;
     let (r, c) = (&*robot.inner, &*routing.inner);
+    let asked = FrictionArgs { mu: friction, regime, history, direction: None };
+    let friction = requested(&asked, c)?;
     let tau = torque_of(torque)?;
     if points > MAX_GRID_POINTS {
         return Err(input(format!(
             "points {points}: at most {MAX_GRID_POINTS} points per axis (time and memory grow as points²)"
         )));
     }
-    JointProbe::new(r, c, joint).map_err(library)?;
+    let mut probe = JointProbe::new(r, c, joint).map_err(library)?;
+    let mu = friction.as_ref().map(|(model, _)| vec1(py, model.friction_coefficients()).unbind());
+    let (regime, history) = friction.as_ref().map_or((None, None), |&(_, regime)| {
+        let (regime, history) = name(regime);
+        (Some(regime), history)
+    });
+    if let Some((model, regime)) = friction {
+        probe = probe.with_friction(c, model, regime).map_err(library)?;
+    }
     let (jx, jy) = (&r.joints()[2 * joint], &r.joints()[2 * joint + 1]);
     let grid = AngleGrid {
         lower: lower.unwrap_or(jx.lower.max(jy.lower)),
@@ -162,7 +185,7 @@ pub fn sweep(
         points,
     };
     let maps = py
-        .detach(|| run(threads, || sweep_joint(r, c, joint, tau, grid, &|_, _| ())))?
+        .detach(|| run(threads, || sweep_probe(&probe, r, c, tau, grid, &|_, _| ())))?
         .map_err(library)?;
     let n = points;
     let map = |f: fn(&sinew::indicators::SweepCell) -> f64| -> PyResult<Py<PyArray2<f64>>> {
@@ -180,5 +203,8 @@ pub fn sweep(
         k_x_max: map(|c| c.k_x.range[1])?,
         k_y_min: map(|c| c.k_y.range[0])?,
         k_y_max: map(|c| c.k_y.range[1])?,
+        regime,
+        history,
+        mu,
     })
 }

@@ -57,3 +57,37 @@ def test_sweep_errors(robot, decoupled):
         sinew.sweep(robot, decoupled, 0, [0.3, 0.3], points=1)
     with pytest.raises(sinew.InputError, match="at most 1001"):
         sinew.sweep(robot, decoupled, 0, [0.3, 0.3], points=5000)
+
+
+@pytest.mark.parametrize(
+    "kwargs, flags",
+    [
+        (dict(regime="pull"), ["--regime", "pull"]),
+        (dict(regime="release"), ["--regime", "release"]),
+        (dict(), []),
+        (dict(history="equal"), ["--history", "equal"]),
+    ],
+)
+def test_sweep_with_friction_against_the_cli(robot, routed, kwargs, flags):
+    s = sinew.sweep(robot, routed, 4, [0.5, -0.3], points=5, friction=0.2, **kwargs)
+    doc = cli("sweep", "--robot", str(CDHRM5), "--model", "routed", "--joint", "5",
+              "--torque", "0.5,-0.3", "--grid", "5", "--friction", "0.2", *flags)
+    assert (s.regime, s.history) == (doc["friction"]["regime"], doc["friction"]["history"])
+    close(s.mu, doc["friction"]["mu"])
+    plain = sinew.sweep(robot, routed, 4, [0.5, -0.3], points=5)
+    assert plain.regime is None and plain.mu is None
+    for name in ["k_x_min", "k_x_max", "k_y_min", "k_y_max"]:
+        ref = np.array([[np.nan if v is None else v for v in row] for row in doc[name]])
+        a = getattr(s, name)
+        assert np.array_equal(np.isnan(a), np.isnan(ref))
+        close(np.nan_to_num(a), np.nan_to_num(ref))
+        assert not np.allclose(np.nan_to_num(a), np.nan_to_num(getattr(plain, name)))
+
+
+def test_sweep_friction_errors(robot, routed):
+    with pytest.raises(sinew.InputError, match="friction"):
+        sinew.sweep(robot, routed, 4, [0.5, -0.3], points=3, friction=-0.1)
+    with pytest.raises(sinew.InputError, match="stick"):
+        sinew.sweep(robot, routed, 4, [0.5, -0.3], points=3, regime="stick")
+    with pytest.raises(sinew.InputError, match="regime"):
+        sinew.sweep(robot, routed, 4, [0.5, -0.3], points=3, friction=0.1, regime="slide")

@@ -385,6 +385,9 @@ class SweepResult:
     k_x_max: F64
     k_y_min: F64
     k_y_max: F64
+    regime: Optional[Regime]
+    history: Optional[History]
+    mu: Optional[F64]
 
 def joint_range(
     robot: Robot, routing: Routing, joint: int, q: ArrayLike, torque: ArrayLike
@@ -398,6 +401,9 @@ def sweep(
     lower: Optional[float] = None,
     upper: Optional[float] = None,
     threads: Optional[int] = None,
+    friction: Optional[float] = None,
+    regime: Optional[Regime] = None,
+    history: Optional[History] = None,
 ) -> SweepResult: ...
 def to_mjcf(
     robot: Robot,
