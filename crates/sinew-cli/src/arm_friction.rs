@@ -315,7 +315,7 @@ pub fn run(
         k_w: faer_rows(k_w.as_ref()),
         j_x: faer_rows(j_x.as_ref()),
         stable,
-        min_eigenvalue: out.margin,
+        min_eigenvalue: out.stability_margin(&mut data).map_err(library_error)?,
         c_x: stable.then(|| faer_rows(out.end.compliance())),
         k_x: full_rank.then(|| faer_rows(out.end.stiffness())),
         k_fd: full_rank.then(|| na_rows(&out.end.k_fd())),

@@ -2,6 +2,7 @@
 //! sense, the certified gap to the method's bound, and the reported matrices. One place for
 //! the frictionless plan and the plan in the stick regime.
 
+use faer::MatRef;
 use nalgebra::{Matrix3, Matrix6};
 use sinew_stiffness::{ArmStiffnessData, StiffnessError};
 
@@ -71,23 +72,33 @@ pub(crate) fn plan_at(
 /// `margin` is sized; its last eigenvector starts the next plan's).
 pub(crate) fn stable_margin(
     sd: &mut ArmStiffnessData,
-    (a, least): &mut (Vec<f64>, LeastEigen),
+    margin: &mut (Vec<f64>, LeastEigen),
 ) -> Result<f64, PlanError> {
     let n = sd.k_q().nrows();
-    a.resize(n * n, 0.0);
-    let k_q = sd.k_q();
+    margin.0.resize(n * n, 0.0);
+    accumulate(&mut margin.0, sd.k_q(), false);
+    accumulate(&mut margin.0, sd.k_w(), true);
+    least_symmetric(margin, Some(0.0))
+}
+
+/// `a` (row by row, `n × n`) set to `m` (`add`: plus `m`).
+pub(crate) fn accumulate(a: &mut [f64], m: MatRef<'_, f64>, add: bool) {
+    let n = m.nrows();
     for (i, row) in a.chunks_exact_mut(n).enumerate() {
         for (j, v) in row.iter_mut().enumerate() {
-            *v = k_q[(i, j)];
+            *v = if add { *v + m[(i, j)] } else { m[(i, j)] };
         }
     }
-    let k_w = sd.k_w();
-    for (i, row) in a.chunks_exact_mut(n).enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v += k_w[(i, j)];
-        }
-    }
+}
+
+/// `λ_min` of the symmetric part of the square matrix in `margin.0` (row by row), by
+/// [`LeastEigen`]: the margin of [`stable_margin`], and of a stick plan's `K_stick + K_W`.
+/// `below`: a value known to be below it (a stable arm's 0), or `None`.
+pub(crate) fn least_symmetric(
+    (a, least): &mut (Vec<f64>, LeastEigen),
+    below: Option<f64>,
+) -> Result<f64, PlanError> {
+    let n = a.len().isqrt();
     crate::dense::symmetrise(a, n);
-    // Stable: λ_min > 0.
-    Ok(least.least(a, n, Some(0.0)).ok_or(StiffnessError::Eigen)?)
+    Ok(least.least(a, n, below).ok_or(StiffnessError::Eigen)?)
 }

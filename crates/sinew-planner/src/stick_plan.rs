@@ -25,10 +25,11 @@ use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, FrictionStiffnessData, History,
 };
 
-use crate::answer::{Evaluated, plan_at};
+use crate::answer::{Evaluated, accumulate, least_symmetric, plan_at};
 use crate::error::{InputProblem, PlanError};
 use crate::frame::Frame;
 use crate::interior;
+use crate::least::LeastEigen;
 use crate::pencil::Pencil;
 use crate::plan::{Planner, PlannerData};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
@@ -42,6 +43,8 @@ pub struct StickPlanData {
     /// (segments, dead band, `K_q`, `C_x`, `K_x` of the stick regime).
     pub friction: FrictionArmData,
     scratch: FrictionStiffnessData,
+    /// The answer's margin, `λ_min(sym(K_stick + K_W))`, by Cholesky trials.
+    margin: (Vec<f64>, LeastEigen),
 }
 
 impl StickPlanData {
@@ -50,6 +53,7 @@ impl StickPlanData {
         StickPlanData {
             friction: FrictionArmData::new(planner.arm(), model),
             scratch: FrictionStiffnessData::new(model),
+            margin: (Vec::new(), LeastEigen::default()),
         }
     }
 }
@@ -114,10 +118,18 @@ impl Planner {
         let regime = (model, FrictionRegime::Stick(history));
         let outcome =
             arm.evaluate_with_friction(sd, out, regime, q, f0, TensionChoice::Given(&tensions))?;
+        let margin = &mut stick.margin;
+        // A plan depends on its arguments alone: no eigenvector of an earlier plan starts it.
+        margin.1.forget();
+        let n = arm.dof();
+        margin.0.resize(n * n, 0.0);
+        accumulate(&mut margin.0, out.stiffness.stiffness()?, false);
+        accumulate(&mut margin.0, sd.k_w(), true);
+        let min_eigenvalue = least_symmetric(margin, outcome.is_stable().then_some(0.0))?;
         if !outcome.is_stable() {
             return Err(PlanError::NoStableTensions {
                 margin: requirements.margin,
-                best: out.margin,
+                best: min_eigenvalue,
                 budget: requirements.budget.is_some(),
             });
         }
@@ -129,7 +141,7 @@ impl Planner {
             History::Equal => arm.statics().levels_of(&sd.cables, &sd.statics, &tensions).ok(),
             History::Pull | History::Release => None,
         };
-        let at = Evaluated { c_x, k_fd, min_eigenvalue: out.margin };
+        let at = Evaluated { c_x, k_fd, min_eigenvalue };
         plan_at(
             objective,
             (&lambda, tensions),

@@ -342,7 +342,7 @@ pub fn evaluate_friction(
         k_w: faer2(k_w.as_ref())?,
         j_x: faer2(j_x.as_ref())?,
         stable,
-        min_eigenvalue: out.margin,
+        min_eigenvalue: out.stability_margin(data).map_err(library)?,
         c_x: stable.then(|| faer2(out.end.compliance())).transpose()?,
         k_x: full_rank.then(|| faer2(out.end.stiffness())).transpose()?,
         k_fd: full_rank.then(|| na2(py, &out.end.k_fd()).into_any().unbind()),

@@ -13,6 +13,9 @@
 //! - `pipeline + slip`, `pipeline + slip + stick`: the pipeline, then what a caller adds today
 //!   for friction with the public API: the cable geometry with Hessians once more (the
 //!   pipeline's own is not exposed), the friction geometry, weights, slip (and stick) stiffness;
+//! - `evaluate_with_friction slip pull`, `… stick pull`: the whole pipeline with friction
+//!   ([`ArmStiffness::evaluate_with_friction`], levels), what the acceptance's "≤ 2× the
+//!   routed pipeline" compares with `pipeline`;
 //! - `part: …`: each friction step alone, on a geometry computed before timing.
 //!
 //! The tensions are the pipeline's own at the pose (their values do not change the cost).
@@ -31,8 +34,8 @@ use sinew_routing::{
 };
 use sinew_statics::TensionChoice;
 use sinew_stiffness::{
-    ArmStiffness, ArmStiffnessData, FrictionStiffnessData, History, joint_stiffness,
-    slip_stiffness, stick_stiffness,
+    ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, FrictionStiffnessData,
+    History, joint_stiffness, slip_stiffness, stick_stiffness,
 };
 use sinew_testkit::cdhrm5;
 
@@ -156,6 +159,22 @@ fn bench_friction(c: &mut Criterion) {
                 case.step(parts);
             };
             run(); // Warm and checked once before timing.
+            group.bench_function(BenchmarkId::new(name, dof), |b| b.iter(&mut run));
+        }
+        // The whole pipeline with friction, as `sinew arm --friction` runs it: the pose stage,
+        // the friction geometry, the regime's tensions (here the paper's levels on each joint's
+        // interval of actuator tensions), its K_q, the end stage.
+        let model = case.model.clone();
+        let mut out = FrictionArmData::new(&pipeline, &model);
+        for (name, regime) in [
+            ("evaluate_with_friction slip pull", FrictionRegime::Slip(Slip::Pull)),
+            ("evaluate_with_friction stick pull", FrictionRegime::Stick(History::Pull)),
+        ] {
+            let mut run = || {
+                let arm = (&model, regime);
+                pipeline.evaluate_with_friction(&mut data, &mut out, arm, &q, &f0, choice).unwrap()
+            };
+            run();
             group.bench_function(BenchmarkId::new(name, dof), |b| b.iter(&mut run));
         }
         // The friction steps one by one, on the geometry of the last step (not timed).

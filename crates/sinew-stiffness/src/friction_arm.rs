@@ -52,8 +52,6 @@ pub struct FrictionArmData {
     pub segments: Vec<Vec<f64>>,
     /// Per cable, the dead band `[T₀^release, T₀^pull]` of its anchor tension (N).
     pub dead_band: Vec<[f64; 2]>,
-    /// The smallest eigenvalue of the symmetric part of `K_q + K_W` (N m/rad).
-    pub margin: f64,
     /// The end's verdict (`None` before an evaluation).
     pub outcome: Option<EndOutcome>,
 }
@@ -69,9 +67,19 @@ impl FrictionArmData {
             actuator: vec![0.0; m],
             segments: vec![Vec::new(); m],
             dead_band: vec![[0.0; 2]; m],
-            margin: f64::NAN,
             outcome: None,
         }
+    }
+
+    /// The stability margin of the last evaluation: the smallest eigenvalue of the symmetric
+    /// part of `K_q + K_W` (N m/rad; positive: stable), `data` the arm's workspace of that
+    /// evaluation (its `K_W`). Computed on demand, as [`ArmStiffnessData::stability_margin`]
+    /// (an eigen-decomposition; allocates): an evaluation's outcome already says stable or not.
+    ///
+    /// # Errors
+    /// [`StiffnessError::StageMissing`] before an evaluation; [`StiffnessError::Eigen`].
+    pub fn stability_margin(&self, data: &mut ArmStiffnessData) -> Result<f64, StiffnessError> {
+        stability_margin(self.stiffness.stiffness()?, data.k_w())
     }
 }
 
@@ -136,7 +144,6 @@ impl ArmStiffness {
         data.fill_k_w();
         let (k_q, k_w, j_x) =
             (out.stiffness.stiffness()?, data.k_w_filled.as_ref(), data.statics.joint_end().j_x());
-        out.margin = stability_margin(k_q, k_w)?;
         let outcome = match end_stiffness(k_q, k_w, j_x, &mut out.end) {
             Ok(()) => EndOutcome::Stiff,
             Err(StiffnessError::Unstable { min_eigenvalue }) => {
