@@ -59,7 +59,7 @@ mod vec3;
 
 pub use error::{JointProblem, Result, RoutingError};
 pub use friction::{
-    DofRow, FrictionData, FrictionModel, Slip, WRAP_KINK, compute_capstan_weights,
+    DofRow, FrictionData, FrictionModel, SegmentRows, Slip, WRAP_KINK, compute_capstan_weights,
     compute_friction_geometry,
 };
 pub use geometry::{

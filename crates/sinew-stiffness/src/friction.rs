@@ -16,7 +16,9 @@
 //! affine in the actuator tensions for a given regime (and history).
 
 use faer::MatRef;
-use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData, Slip};
+use sinew_routing::{
+    FrictionData, FrictionModel, Routing, RoutingError, SegmentHessians, SegmentRows, Slip,
+};
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
@@ -68,8 +70,12 @@ pub struct FrictionStiffnessData {
     pub(crate) stiffness: ColMajor,
     pub(crate) symmetric: ColMajor,
     pub(crate) skew_norm: f64,
-    /// Scratch, one per DOF: `Σ_s c_s ∂w_s/∂Q` of one cable (slip).
-    pub(crate) gradient: Vec<f64>,
+    /// Scratch (slip), m × dof: row `c` is `J_c / C̃_c` for a cable with friction, else 0.
+    pub(crate) series_elastic: ColMajor,
+    /// Scratch (slip), dof × m: column `c` is `T_0 g_c / C̃_c`, `g_c = Σ_s c_s ∂w_s/∂Q`.
+    pub(crate) moving_series_t: ColMajor,
+    /// Scratch (slip), dof × dof: `T_0 Σ_s ∇w_sᵀ J_s`, the transpose of its term of `K`.
+    pub(crate) moving_transposed: ColMajor,
 }
 
 impl FrictionStiffnessData {
@@ -85,7 +91,9 @@ impl FrictionStiffnessData {
             stiffness: ColMajor::zeros(n, n),
             symmetric: ColMajor::zeros(n, n),
             skew_norm: 0.0,
-            gradient: vec![0.0; n],
+            series_elastic: ColMajor::zeros(m, n),
+            moving_series_t: ColMajor::zeros(n, m),
+            moving_transposed: ColMajor::zeros(n, n),
         }
     }
 
@@ -204,22 +212,28 @@ impl FrictionStiffnessData {
     }
 }
 
-/// `out[dofs, dofs] += scale · H_s` for friction segment `s ≥ 1` of cable `c` (the routing's
-/// segment Hessian, entry by entry column by column: the order of
-/// `RoutingData::add_weighted_hessians`).
+/// `out[dofs, dofs] += scale · H_s` for the friction segment `segment` (the routing's segment
+/// Hessian from `hessians`, over `J_s`'s DOFs, entry by entry column by column: the order of
+/// `RoutingData::add_weighted_hessians`); nothing for the free length.
 pub(crate) fn add_segment_hessian(
-    model: &FrictionModel,
-    routing: &Routing,
-    geometry: &RoutingData,
-    (c, s): (usize, usize),
+    (routing, hessians): (&Routing, &SegmentHessians<'_>),
+    segment: &SegmentRows<'_>,
     scale: f64,
     out: &mut ColMajor,
 ) -> Result<(), StiffnessError> {
-    if let Some((dofs, h)) = model.segment_hessian(routing, geometry, c, s)? {
-        for (k, col) in dofs.clone().enumerate() {
-            for (i, row) in dofs.clone().enumerate() {
-                *out.at_mut(row, col) += scale * h[(i, k)];
-            }
+    let Some(r) = segment.routing_segment else {
+        return Ok(());
+    };
+    let Some(h) = hessians.get(r) else {
+        let expected = routing.segments().len();
+        return Err(
+            RoutingError::DimensionMismatch { what: "segment index", expected, got: r }.into()
+        );
+    };
+    let dofs = segment.jacobian.dofs.clone();
+    for (k, col) in dofs.clone().enumerate() {
+        for (i, o) in out.col_mut(col)[dofs.clone()].iter_mut().enumerate() {
+            *o += scale * h[(i, k)];
         }
     }
     Ok(())

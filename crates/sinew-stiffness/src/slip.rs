@@ -43,6 +43,8 @@
 //! (`sinew_routing::Cable::stiffness`), summed in today's order: with every μ = 0 the result is
 //! [`crate::joint_stiffness`]'s bit for bit.
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Par};
 use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
 use crate::error::StiffnessError;
@@ -81,10 +83,11 @@ pub fn slip_stiffness(
     let j_c = geometry.jacobian()?;
     // Pass 1, every cable: Σ_s T_0 w_s H_s (w_s = 1 exactly at μ = 0: today's Σ f_c H_c in its
     // order); the μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal, then mirrored.
+    let hessians = (routing, &geometry.segment_hessians(routing)?);
     for (c, &t_0) in actuator.iter().enumerate() {
-        let weights = friction.weights(model, c)?;
-        for (s, &w) in weights.iter().enumerate().skip(1) {
-            add_segment_hessian(model, routing, geometry, (c, s), t_0 * w, &mut out.controllable)?;
+        for segment in friction.segments(model, c)?.skip(1) {
+            let w = segment.weight.unwrap_or(1.0);
+            add_segment_hessian(hessians, &segment, t_0 * w, &mut out.controllable)?;
         }
         if mu[c] == 0.0 {
             let cable = &routing.cables()[c];
@@ -98,49 +101,63 @@ pub fn slip_stiffness(
         }
     }
     out.mirror_inherent();
-    // Pass 2, the cables with friction: the pieces in series.
+    // Pass 2, the cables with friction: the pieces in series. Per cable, the rows
+    // `J_c / C̃` and `T_0 g / C̃` of two m × dof matrices, and `T_0 Σ_s J_sᵀ ∇w_s` transposed
+    // (each `∇w_s` a contiguous row: one axpy per DOF of `J_s`); then `J̃ᵀ` times each matrix
+    // (faer's product: the cables' rank-one terms `J̃_cᵀ (…)` summed at once).
+    if mu.iter().all(|&mu| mu == 0.0) {
+        out.finish(FrictionRegime::Slip(slip));
+        return Ok(());
+    }
     let ea = axial_rigidity(routing);
     let j_tilde = friction.effective_jacobian()?;
+    out.series_elastic.as_mut_slice().fill(0.0);
+    out.moving_series_t.as_mut_slice().fill(0.0);
+    out.moving_transposed.as_mut_slice().fill(0.0);
     for (c, &t_0) in actuator.iter().enumerate() {
         if mu[c] == 0.0 {
             continue;
         }
-        let (lengths, weights) = (friction.lengths(model, c)?, friction.weights(model, c)?);
-        // The cable's DOFs (J_c, J̃) and those its last weight's gradient reaches (the union of
-        // every ∇w_s's).
-        let rows = routing.cables()[c].dofs.clone();
-        let reach = friction.weight_gradient(model, c, lengths.len() - 1)?.dofs;
-        let cols = if reach.is_empty() {
-            rows.clone()
-        } else {
-            rows.start.min(reach.start)..rows.end.max(reach.end)
-        };
-        out.gradient[cols.clone()].fill(0.0);
-        let mut series = 0.0;
-        for (s, (&l, &w)) in lengths.iter().zip(weights).enumerate() {
-            let c_s = l / ea;
+        // g = Σ_s c_s ∇w_s accumulates in column c of the transposed scratch (contiguous).
+        let (mut series, mut reach) = (0.0, 0..0);
+        for segment in friction.segments(model, c)? {
+            let (Some(w), Some(grad_w)) = (segment.weight, segment.weight_gradient) else {
+                let computed = friction.slip();
+                return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed });
+            };
+            let c_s = segment.length / ea;
             series += c_s * w;
-            let grad_w = friction.weight_gradient(model, c, s)?;
-            for (g, d) in grad_w.values.iter().zip(grad_w.dofs.clone()) {
-                out.gradient[d] += c_s * g;
+            let g = &mut out.moving_series_t.col_mut(c)[grad_w.dofs.clone()];
+            for (o, v) in g.iter_mut().zip(grad_w.values) {
+                *o += c_s * v;
             }
-            // T_0 J_sᵀ ∇w_s.
-            let j_s = friction.segment_jacobian(model, c, s)?;
-            for (g, j) in grad_w.values.iter().zip(grad_w.dofs.clone()) {
-                let tg = t_0 * g;
-                for (v, i) in j_s.values.iter().zip(j_s.dofs.clone()) {
-                    *out.controllable.at_mut(i, j) += v * tg;
+            // T_0 J_sᵀ ∇w_s, transposed: column i of the scratch += T_0 J_s[i] ∇w_s.
+            let j_s = segment.jacobian;
+            for (v, i) in j_s.values.iter().zip(j_s.dofs.clone()) {
+                let tv = t_0 * v;
+                let column = &mut out.moving_transposed.col_mut(i)[grad_w.dofs.clone()];
+                for (o, g) in column.iter_mut().zip(grad_w.values) {
+                    *o += tv * g;
                 }
             }
+            reach = grad_w.dofs;
         }
-        // J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
-        for j in cols.clone() {
-            let (a, b) = (j_c[(c, j)] / series, t_0 * out.gradient[j] / series);
-            for i in rows.clone() {
-                let jt = j_tilde[(c, i)];
-                *out.inherent.at_mut(i, j) += jt * a;
-                *out.controllable.at_mut(i, j) -= jt * b;
-            }
+        // The rows of J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
+        for j in routing.cables()[c].dofs.clone() {
+            *out.series_elastic.at_mut(c, j) = j_c[(c, j)] / series;
+        }
+        for v in &mut out.moving_series_t.col_mut(c)[reach] {
+            *v *= t_0 / series;
+        }
+    }
+    let (elastic, moving) = (out.series_elastic.as_ref(), out.moving_series_t.as_ref().transpose());
+    let (inherent, controllable) = (out.inherent.as_mut(), out.controllable.as_mut());
+    matmul(inherent, Accum::Add, j_tilde.transpose(), elastic, 1.0, Par::Seq);
+    matmul(controllable, Accum::Add, j_tilde.transpose(), moving, -1.0, Par::Seq);
+    let n = out.dof;
+    for j in 0..n {
+        for i in 0..n {
+            *out.controllable.at_mut(i, j) += out.moving_transposed.at(j, i);
         }
     }
     out.finish(FrictionRegime::Slip(slip));

@@ -57,18 +57,17 @@ pub fn stick_stiffness(
         check_weights(friction, slip)?;
     }
     let ea = axial_rigidity(routing);
+    let hessians = (routing, &geometry.segment_hessians(routing)?);
     for (c, &t_0) in actuator.iter().enumerate() {
-        let lengths = friction.lengths(model, c)?;
-        let weights = match history {
-            History::Equal => None,
-            History::Pull | History::Release => Some(friction.weights(model, c)?),
-        };
-        for s in 1..lengths.len() {
-            let t_s = weights.map_or(t_0, |w| t_0 * w[s]);
-            add_segment_hessian(model, routing, geometry, (c, s), t_s, &mut out.controllable)?;
+        for segment in friction.segments(model, c)?.skip(1) {
+            let t_s = match history {
+                History::Equal => t_0,
+                History::Pull | History::Release => t_0 * segment.weight.unwrap_or(1.0),
+            };
+            add_segment_hessian(hessians, &segment, t_s, &mut out.controllable)?;
             // J_sᵀ k_s J_s on and above the diagonal (mirrored below once every cable is in).
-            let j_s = friction.segment_jacobian(model, c, s)?;
-            let k_s = ea / lengths[s];
+            let j_s = &segment.jacobian;
+            let k_s = ea / segment.length;
             for (jj, j) in j_s.dofs.clone().enumerate() {
                 let kj = k_s * j_s.values[jj];
                 for (ii, i) in j_s.dofs.clone().enumerate().take(jj + 1) {

@@ -25,6 +25,21 @@ fn the_friction_stiffness_allocates_nothing() {
         assert!(built > 0, "the counter counts nothing");
         let tensions = vec![50.0; routing.cable_count()];
         let qs = config::random_qs(&robot, 5, 5);
+        // One evaluation before counting: faer's matrix product (the slip stiffness's series
+        // terms) allocates once, on its first use in the process (measured: 1, then none).
+        compute_cable_geometry(
+            &routing,
+            &robot,
+            &mut rdata,
+            &mut geometry,
+            &qs[0],
+            Order::Hessians,
+        )
+        .unwrap();
+        compute_friction_geometry(&model, &routing, &geometry, &mut friction).unwrap();
+        compute_capstan_weights(&model, &mut friction, Slip::Pull).unwrap();
+        slip_stiffness(&model, &routing, &geometry, &friction, Slip::Pull, &tensions, &mut out)
+            .unwrap();
         let (allocations, checksum) = count(|| {
             let mut checksum = 0.0;
             for q in &qs {

@@ -24,6 +24,24 @@ impl DofRow<'_> {
     }
 }
 
+/// One friction segment of a cable at the computed geometry, as
+/// [`FrictionData::segments`] yields them: what the stiffness of every regime reads per
+/// segment, checked once per cable instead of once per access.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentRows<'a> {
+    /// `ℓ_s`, m (segment 0: the free length).
+    pub length: f64,
+    /// `w_s` of the last regime's weights (`None` before [`crate::compute_capstan_weights`]).
+    pub weight: Option<f64>,
+    /// `J_s` over the segment's DOFs ([`FrictionData::segment_jacobian`]).
+    pub jacobian: DofRow<'a>,
+    /// `∂w_s/∂Q` ([`FrictionData::weight_gradient`]; `None` before the weights).
+    pub weight_gradient: Option<DofRow<'a>>,
+    /// The routing segment it is (`None` for segment 0, the free length): its Hessian block is
+    /// `H_s` over [`SegmentRows::jacobian`]'s DOFs ([`crate::SegmentHessians::get`]).
+    pub routing_segment: Option<usize>,
+}
+
 /// The reusable workspace of a [`FrictionModel`] (Pinocchio's *data*): the friction geometry
 /// at one configuration and one slip regime's weights, sized once so that computing them
 /// allocates nothing. Rows are indexed as in the module docs of `crate::friction`: per cable,
@@ -172,6 +190,28 @@ impl FrictionData {
     pub fn weight_gradient(&self, model: &FrictionModel, c: usize, s: usize) -> Result<DofRow<'_>> {
         self.weights_of(model, c)?;
         Ok(row(&self.weight_gradients, &model.entry(c, s)?.weight))
+    }
+
+    /// Cable `c`'s friction segments from the actuator to the anchor (`H` of them), the
+    /// workspace checked against `model` once: the loops of the regimes' stiffness.
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`].
+    pub fn segments<'a>(
+        &'a self,
+        model: &'a FrictionModel,
+        c: usize,
+    ) -> Result<impl ExactSizeIterator<Item = SegmentRows<'a>> + 'a> {
+        let range = self.geometry_of(model, c)?;
+        let weighted = self.slip.is_some();
+        let entries = model.entries.get(range.clone()).unwrap_or(&[]);
+        Ok(entries.iter().zip(range).map(move |(entry, e)| SegmentRows {
+            length: self.lengths[e],
+            weight: weighted.then(|| self.weights[e]),
+            jacobian: row(&self.jacobians, &entry.jacobian),
+            weight_gradient: weighted.then(|| row(&self.weight_gradients, &entry.weight)),
+            routing_segment: entry.routing,
+        }))
     }
 
     /// The effective cable Jacobian `J̃_c = Σ_s w_{c,s} J_{c,s}` of the last regime, m × dof,

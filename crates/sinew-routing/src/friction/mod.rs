@@ -68,7 +68,7 @@ mod geometry;
 mod model;
 mod weights;
 
-pub use data::{DofRow, FrictionData};
+pub use data::{DofRow, FrictionData, SegmentRows};
 pub use geometry::{WRAP_KINK, compute_friction_geometry};
 pub use model::{FrictionModel, Slip};
 pub use weights::compute_capstan_weights;
