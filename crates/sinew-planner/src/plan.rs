@@ -42,6 +42,8 @@ pub struct PlannerData {
     pub(crate) pencil: Option<Pencil>,
     /// The answer's `sym(K_q + K_W)` (row-major) and its least eigenvalue's workspace.
     pub(crate) margin: (Vec<f64>, LeastEigen),
+    /// The last plan's equilibrium set: the next pose's is copied into its buffers.
+    set: Option<EquilibriumSet>,
 }
 
 impl PlannerData {
@@ -53,6 +55,7 @@ impl PlannerData {
             active: None,
             pencil: None,
             margin: (Vec::new(), LeastEigen::default()),
+            set: None,
         }
     }
 
@@ -125,6 +128,15 @@ impl Planner {
         let sd = &mut data.stiffness;
         // The pose stage, once: geometry, T0, K_W and J_x at the pose.
         arm.set_pose(sd, q, f0)?;
+        // The statics' set, copied into the last plan's buffers (the statics keep theirs).
+        let mut kept = data.set.take();
+        let mut own = |source: &EquilibriumSet| match kept.take() {
+            Some(mut set) => {
+                set.clone_from(source);
+                set
+            }
+            None => source.clone(),
+        };
         let fixed = self.fixed_tensions(sd, requirements)?;
         let (set, least_total) = match settings.method {
             // The equilibrium set and one tension stage (the pencil needs the stage's inherent
@@ -132,7 +144,7 @@ impl Planner {
             // first phase. Any balancing tensions within the limits do: the closed form's
             // lowest levels when it holds them (no program), else the least-total policy.
             Method::InteriorPoint => {
-                let set = arm.equilibrium_set(sd)?.clone();
+                let set = own(arm.equilibrium_set(sd)?);
                 let by_levels = arm.statics().has_levels()
                     && arm.set_tensions(sd, TensionChoice::Default).is_ok();
                 if !by_levels {
@@ -145,7 +157,7 @@ impl Planner {
             Method::Bundle => {
                 arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))?;
                 let least_total: f64 = sd.tensions().iter().sum();
-                let set = arm.equilibrium_set(sd)?.clone();
+                let set = own(arm.equilibrium_set(sd)?);
                 if let Some(budget) = requirements.budget
                     && least_total > budget * (1.0 + 1e-12)
                 {
@@ -215,7 +227,11 @@ impl Planner {
         };
         data.pencil = Some(pencil);
         let plan = self.answer(data, &set, objective, requirements, &lambda, upper, iterations)?;
-        data.previous = Some(plan.tensions.clone());
+        // The tensions into the last ones' buffer.
+        let mut kept = previous.unwrap_or_default();
+        kept.clone_from(&plan.tensions);
+        data.previous = Some(kept);
+        data.set = Some(set);
         Ok((plan, warm, iterations))
     }
 

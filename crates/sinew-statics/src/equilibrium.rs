@@ -38,7 +38,7 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 
 use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
-use crate::set_block::{Block, BlockSet};
+use crate::set_block::{Block, BlockSet, copy_matrix};
 
 /// The relative equilibrium residual `|T0 + J_cᵀ f| / |T0|` accepted as balance.
 pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-9;
@@ -52,7 +52,7 @@ pub(crate) const NAMED_SHARE: f64 = 0.1;
 /// Built per configuration by [`EquilibriumSet::new`] (it allocates; an SVD of each block of
 /// `J_c` that is not a three-cable joint); the
 /// tension policies of [`crate::TensionPolicy`] choose a point of it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct EquilibriumSet {
     particular: Vec<f64>,
     null: Mat<f64>,
@@ -87,12 +87,17 @@ fn independent_blocks(jacobian: MatRef<'_, f64>) -> Vec<(Vec<usize>, Vec<usize>)
             }
         }
     }
-    let mut blocks: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::new();
+    let mut blocks: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::with_capacity(dof);
     for d in 0..dof {
         let r = root(&mut parent, d);
         match blocks.iter_mut().find(|b| b.0 == r) {
             Some(b) => b.2.push(d),
-            None => blocks.push((r, Vec::new(), vec![d])),
+            None => {
+                // A universal joint's block: two DOFs, three cables (room for both, at once).
+                let mut dofs = Vec::with_capacity(2);
+                dofs.push(d);
+                blocks.push((r, Vec::with_capacity(3), dofs));
+            }
         }
     }
     let mut lone = Vec::new();
@@ -108,6 +113,30 @@ fn independent_blocks(jacobian: MatRef<'_, f64>) -> Vec<(Vec<usize>, Vec<usize>)
         }
     }
     blocks.into_iter().map(|(_, cables, dofs)| (cables, dofs)).chain(lone).collect()
+}
+
+impl Clone for EquilibriumSet {
+    fn clone(&self) -> EquilibriumSet {
+        EquilibriumSet {
+            particular: self.particular.clone(),
+            null: self.null.clone(),
+            lower: self.lower.clone(),
+            upper: self.upper.clone(),
+            blocks: self.blocks.clone(),
+            dof: self.dof,
+        }
+    }
+
+    /// Into the buffers already there when the shapes agree: a planner re-planning along a
+    /// trajectory copies each step's set into the last one's storage, allocating nothing.
+    fn clone_from(&mut self, source: &EquilibriumSet) {
+        self.particular.clone_from(&source.particular);
+        copy_matrix(&mut self.null, &source.null);
+        self.lower.clone_from(&source.lower);
+        self.upper.clone_from(&source.upper);
+        self.blocks.clone_from(&source.blocks);
+        self.dof = source.dof;
+    }
 }
 
 impl EquilibriumSet {
@@ -140,9 +169,10 @@ impl EquilibriumSet {
             return Err(StaticsError::NonFiniteInput { what: "cable Jacobian or T0" });
         }
         let mut particular = vec![0.0; m];
-        let mut null_columns: Vec<Vec<(usize, f64)>> = Vec::new();
-        let mut blocks = Vec::new();
-        for (cables, dofs) in independent_blocks(jacobian) {
+        let independent = independent_blocks(jacobian);
+        let mut null_columns: Vec<Vec<(usize, f64)>> = Vec::with_capacity(m);
+        let mut blocks = Vec::with_capacity(independent.len());
+        for (cables, dofs) in independent {
             if cables.is_empty() {
                 continue; // DOFs no cable moves: the residual check below names them.
             }

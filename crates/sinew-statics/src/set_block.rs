@@ -29,12 +29,40 @@ pub const SET_RANK_TOLERANCE: f64 = 1e-10;
 
 /// An independent block of `J_c`: cables that move only these DOFs, DOFs that only these
 /// cables move, with `J⁺` (DOFs × cables) and `J` on its numerical range (cables × DOFs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub(crate) struct Block {
     pub(crate) cables: Vec<usize>,
     pub(crate) dofs: Vec<usize>,
     pub(crate) pseudo_inverse: Mat<f64>,
     pub(crate) range: Mat<f64>,
+}
+
+impl Clone for Block {
+    fn clone(&self) -> Block {
+        Block {
+            cables: self.cables.clone(),
+            dofs: self.dofs.clone(),
+            pseudo_inverse: self.pseudo_inverse.clone(),
+            range: self.range.clone(),
+        }
+    }
+
+    /// Into the buffers already there (a planner keeps one set per step).
+    fn clone_from(&mut self, source: &Block) {
+        self.cables.clone_from(&source.cables);
+        self.dofs.clone_from(&source.dofs);
+        copy_matrix(&mut self.pseudo_inverse, &source.pseudo_inverse);
+        copy_matrix(&mut self.range, &source.range);
+    }
+}
+
+/// `target = source`, in `target`'s storage when the shapes agree.
+pub(crate) fn copy_matrix(target: &mut Mat<f64>, source: &Mat<f64>) {
+    if (target.nrows(), target.ncols()) == (source.nrows(), source.ncols()) {
+        target.copy_from(source);
+    } else {
+        *target = source.clone();
+    }
 }
 
 /// A block's share of the equilibrium set: the block, `f_p` on its cables (in the block's

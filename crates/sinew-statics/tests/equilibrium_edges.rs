@@ -189,3 +189,37 @@ fn an_unreachable_load_names_the_joints_with_a_tenth_of_its_largest_component() 
     }
     assert_eq!(why.joints, vec![0, 1, 2]);
 }
+
+#[test]
+fn a_set_copied_into_another_ones_buffers_equals_it() {
+    // `clone_from` reuses the target's storage (a planner along a trajectory): whatever the
+    // target held before (another load, other blocks, another size), the copy equals the source.
+    let (j, groups) = two_joints();
+    let coupled = jacobian(&[
+        &[0.02, 0.01, 0.0, 0.0],
+        &[-0.01, -0.01, 0.01, 0.0],
+        &[-0.01, 0.03, 0.0, 0.02],
+        &[0.0, 0.0, 0.015, 0.005],
+        &[0.0, 0.0, -0.02, 0.01],
+        &[0.0, 0.0, 0.004, -0.025],
+        &[0.0, 0.0, 0.0, 0.0],
+    ]);
+    let a =
+        EquilibriumSet::new(j.as_ref(), &[-0.4, 0.3, 0.2, -0.5], &[LIMITS; 7], &groups).unwrap();
+    let b = EquilibriumSet::new(j.as_ref(), &[0.1, 0.2, -0.3, 0.4], &[[10.0, 90.0]; 7], &groups)
+        .unwrap();
+    let c = EquilibriumSet::new(coupled.as_ref(), &[0.1, 0.2, -0.3, 0.4], &[LIMITS; 7], &groups)
+        .unwrap();
+    let (small, small_groups) =
+        (jacobian(&[&[0.02, 0.0], &[-0.01, -0.01], &[-0.01, 0.03]]), [0..2]);
+    let d = EquilibriumSet::new(small.as_ref(), &[0.1, -0.2], &[LIMITS; 3], &small_groups).unwrap();
+    assert_ne!(a, b);
+    assert_ne!(a, c);
+    for source in [&a, &b, &c, &d] {
+        for target in [&a, &b, &c, &d] {
+            let mut copy = target.clone();
+            copy.clone_from(source);
+            assert_eq!(&copy, source);
+        }
+    }
+}
