@@ -42,7 +42,11 @@ fn stable_points(f: &Frame, margin: f64, count: usize, seed: u64) -> Vec<Vec<f64
         s
     };
     let mut out = Vec::new();
-    while out.len() < count {
+    // Bounded: a broken frame (no stable point) fails the test instead of hanging it.
+    for _ in 0..100_000 {
+        if out.len() == count {
+            break;
+        }
         let x: Vec<f64> = (0..f.vars()).map(|_| rng.random_range(-1.0..1.0)).collect();
         let mut s = vec![0.0; sdp.rhs.len()];
         sdp.slacks(&x, &mut s);
@@ -52,6 +56,7 @@ fn stable_points(f: &Frame, margin: f64, count: usize, seed: u64) -> Vec<Vec<f64
             out.push(x);
         }
     }
+    assert_eq!(out.len(), count, "stable points found in 100 000 draws");
     out
 }
 

@@ -10,6 +10,8 @@
 //! optimum (the certificate's `[lo, hi]`). Scaling `x` to it and each matrix block by its
 //! diagonal makes the method's numbers O(1) (`λ ~ 10² N`, `A_i ~ 10⁻² N m/rad per N`).
 
+use std::ops::Range;
+
 use sinew_statics::EquilibriumSet;
 
 use crate::bundle::Linear;
@@ -84,22 +86,23 @@ impl Frame {
             }
         }
         // The symmetric parts, row-major, from the pencil's columns (`a[(r, c)]` is entry `r`
-        // of column `c`).
-        let symmetric = |a: &faer::Mat<f64>, scale: f64, out: &mut [f64]| {
-            for c in 0..n {
-                let column = a.col_as_slice(c);
-                // A decoupled `A_i` is one 2 × 2 joint block: skip its zeros.
-                for (r, v) in column.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+        // of column `c`) over the rows and columns `span` where the matrix can be non-zero
+        // (a decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`).
+        let symmetric = |a: &faer::Mat<f64>, span: Range<usize>, scale: f64, out: &mut [f64]| {
+            for c in span.clone() {
+                for (r, v) in a.col_as_slice(c)[span.clone()].iter().enumerate() {
+                    let r = r + span.start;
                     out[r * n + c] += 0.5 * scale * v;
                     out[c * n + r] += 0.5 * scale * v;
                 }
             }
         };
+        let span = |i: usize| pencil.spans.get(i).cloned().unwrap_or(0..n);
         let mut a0 = vec![0.0; n * n];
-        symmetric(&pencil.a0, 1.0, &mut a0);
-        for (l, a) in base.iter().zip(&pencil.ai) {
+        symmetric(&pencil.a0, 0..n, 1.0, &mut a0);
+        for (i, (l, a)) in base.iter().zip(&pencil.ai).enumerate() {
             if *l != 0.0 {
-                symmetric(a, *l, &mut a0);
+                symmetric(a, span(i), *l, &mut a0);
             }
         }
         let ai: Vec<Vec<f64>> = free
@@ -107,7 +110,7 @@ impl Frame {
             .zip(&width)
             .map(|(&i, w)| {
                 let mut out = vec![0.0; n * n];
-                symmetric(&pencil.ai[i], *w, &mut out);
+                symmetric(&pencil.ai[i], span(i), *w, &mut out);
                 out
             })
             .collect();

@@ -35,6 +35,10 @@ pub(crate) struct Pencil {
     pub(crate) weights: Vec<f64>,
     /// Scratch: `K_W`.
     pub(crate) k_w: Mat<f64>,
+    /// The DOFs `A_i` can be non-zero on (rows and columns): the union of the cables' DOFs
+    /// that `N`'s column `i` weighs (`A_i = Σ_c N_ci H_c`, and `H_c` lives on cable `c`'s
+    /// DOFs; so does its stick stiffness). A decoupled `A_i` is one joint's 2 × 2 block.
+    pub(crate) spans: Vec<std::ops::Range<usize>>,
 }
 
 /// The end quantities at a point where `A ≻ 0`.
@@ -77,6 +81,7 @@ impl Pencil {
             sd.cables.add_weighted_hessians(routing, &self.weights, a.as_mut())?;
         }
         self.copy_j_x(sd.j_x());
+        self.fill_spans(arm, set);
         Ok(())
     }
 
@@ -117,10 +122,27 @@ impl Pencil {
             }
         }
         self.copy_j_x(sd.j_x());
+        self.fill_spans(arm, set);
         Ok(())
     }
 
     /// `A_0`, `K_W` and `k` coefficients of `dof × dof`, zero.
+    /// [`Pencil::spans`] of `set`'s null basis over `arm`'s cables.
+    fn fill_spans(&mut self, arm: &ArmStiffness, set: &EquilibriumSet) {
+        let (cables, null) = (arm.routing().cables(), set.null_basis());
+        self.spans.clear();
+        for i in 0..set.dimension() {
+            let span = (0..set.cable_count().min(cables.len()))
+                .filter(|&c| null[(c, i)] != 0.0)
+                .map(|c| &cables[c].dofs)
+                .fold(None, |acc: Option<std::ops::Range<usize>>, d| match acc {
+                    None => Some(d.clone()),
+                    Some(a) => Some(a.start.min(d.start)..a.end.max(d.end)),
+                });
+            self.spans.push(span.unwrap_or(0..0));
+        }
+    }
+
     fn size(&mut self, dof: usize, k: usize) {
         let reset = |a: &mut Mat<f64>| {
             if a.nrows() == dof && a.ncols() == dof {
@@ -152,6 +174,7 @@ impl Pencil {
             j_x: Mat::zeros(0, 0),
             weights: Vec::new(),
             k_w: Mat::zeros(0, 0),
+            spans: Vec::new(),
         }
     }
 
