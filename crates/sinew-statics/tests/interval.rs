@@ -183,3 +183,68 @@ fn tensions_at_a_limit_are_exactly_on_it() {
     }
     assert!(checked > 100, "only {checked} feasible cases");
 }
+
+#[test]
+fn actuator_intervals_with_limits_of_their_own() {
+    use sinew_statics::actuator_interval;
+    let mut rng = config::rng(22);
+    let common = [LIMITS.f_min, LIMITS.f_max];
+    let (mut checked, mut swapped) = (0, 0);
+    for _ in 0..400 {
+        let block = joint_block(&mut rng);
+        let tau = Vector2::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
+        // With the common limits: the closed form, bit for bit.
+        if let Ok(plain) = tension_interval(3, &block, &tau, LIMITS) {
+            let same = actuator_interval((3, 9), &block, &tau, LIMITS, [common; 3]).unwrap();
+            assert_eq!(same.scaled, plain);
+            assert_eq!(same.ends(), plain.ends());
+        }
+        // Limits of their own: balanced, within each cable's limits, a cable on a limit at
+        // each end, the least total first.
+        let limits: [[f64; 2]; 3] = std::array::from_fn(|_| {
+            let lo = rng.random_range(20.0..60.0);
+            [lo, rng.random_range(200.0..600.0)]
+        });
+        let Ok(interval) = actuator_interval((3, 9), &block, &tau, LIMITS, limits) else {
+            continue;
+        };
+        let (low, high) = interval.ends();
+        for f in [low, high] {
+            let residual = tau + block.transpose() * f;
+            assert!(residual.norm() <= 1e-12 * (1.0 + tau.norm()), "{residual}");
+            for (c, l) in limits.iter().enumerate() {
+                assert!(f[c] >= l[0] - 1e-9 && f[c] <= l[1] + 1e-9, "cable {c}: {} in {l:?}", f[c]);
+            }
+            let tight =
+                (0..3).any(|c| (f[c] - limits[c][0]).abs().min((f[c] - limits[c][1]).abs()) < 1e-9);
+            assert!(tight, "{f}");
+        }
+        assert!(low.sum() <= high.sum());
+        swapped += usize::from(interval.alpha.dot(&interval.scaled.null) < 0.0);
+        checked += 1;
+    }
+    assert!(checked > 100, "{checked} feasible cases");
+    // An empty cable interval is refused, naming the cable in the routing.
+    let block = joint_block(&mut rng);
+    let err = actuator_interval(
+        (3, 9),
+        &block,
+        &Vector2::zeros(),
+        LIMITS,
+        [common, [50.0, 40.0], common],
+    );
+    assert!(matches!(err, Err(StaticsError::EmptyActuatorInterval { cable: 10, .. })), "{err:?}");
+    assert_eq!(swapped, 0, "random blocks are in force closure");
+    // Not in force closure, null direction ∝ (1, 1, −3), the first two cables' limits narrow:
+    // the scaled direction (∝ (10, 10, −3)) has a positive sum, the actuator tensions' total
+    // falls along λ, so the ends swap.
+    let block = Matrix3x2::new(0.01, 0.03, -0.01, 0.0, 0.0, 0.01);
+    let held = Vector3::new(50.0, 50.0, 300.0);
+    let tau = -(block.transpose() * held);
+    let limits = [[20.0, 80.0], [20.0, 80.0], common];
+    let interval = actuator_interval((0, 0), &block, &tau, LIMITS, limits).unwrap();
+    assert!(interval.alpha.dot(&interval.scaled.null) < 0.0);
+    let (low, high) = interval.ends();
+    assert!(low.sum() < high.sum() - 1.0, "{low} {high}");
+    assert_eq!(high, interval.tensions(interval.scaled.lambda_min));
+}
