@@ -16,7 +16,9 @@
 //! - `evaluate_with_friction slip pull`, `… stick pull`: the whole pipeline with friction
 //!   ([`ArmStiffness::evaluate_with_friction`], levels), what the acceptance's "≤ 2× the
 //!   routed pipeline" compares with `pipeline`;
-//! - `part: …`: each friction step alone, on a geometry computed before timing.
+//! - `part: …`: each friction step alone, on a geometry computed before timing; the stick load
+//!   limit after `equal` along 1 and 13 directions beside one solve of `K_stick + K_W` (the
+//!   acceptance: "at most one extra solve per direction").
 //!
 //! The tensions are the pipeline's own at the pose (their values do not change the cost).
 //! docs/performance.md ("Issue #27: what friction costs") has the numbers.
@@ -26,6 +28,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
+use faer::linalg::solvers::Solve;
 use nalgebra::Vector6;
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{
@@ -35,7 +38,7 @@ use sinew_routing::{
 use sinew_statics::TensionChoice;
 use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, FrictionStiffnessData,
-    History, joint_stiffness, slip_stiffness, stick_stiffness,
+    History, base_directions, joint_stiffness, slip_stiffness, stick_load_limits, stick_stiffness,
 };
 use sinew_testkit::cdhrm5;
 
@@ -194,6 +197,28 @@ fn bench_friction(c: &mut Criterion) {
             b.iter(|| {
                 stick_stiffness(model, routing, g, f, History::Pull, black_box(t), out).unwrap()
             })
+        });
+        // The stick load limit after `equal` (every band has room): one factorisation of
+        // K_stick + K_W, then per direction one solve and one pass over the holes. One
+        // direction, then the twelve base directions and the load's; and one solve alone.
+        stick_stiffness(model, routing, g, f, History::Equal, t, out).unwrap();
+        let (k_stick, k_w, j_x) = (out.stiffness().unwrap(), data.k_w().to_owned(), data.j_x());
+        let mut directions = base_directions().to_vec();
+        directions.push(Vector6::new(0.3, 1.0, -0.2, 0.0, 0.0, 0.0));
+        let mats = (k_stick, k_w.as_ref(), j_x);
+        for count in [1, 13] {
+            let name = format!("part: stick load limits, {count} directions");
+            let dirs = &directions[..count];
+            group.bench_function(BenchmarkId::new(name, dof), |b| {
+                b.iter(|| {
+                    stick_load_limits(model, routing, f, History::Equal, t, mats, dirs).unwrap()
+                })
+            });
+        }
+        let lu = Mat::from_fn(dof, dof, |i, j| k_stick[(i, j)] + k_w[(i, j)]).partial_piv_lu();
+        let rhs = Mat::from_fn(dof, 1, |i, _| j_x[(1, i)]);
+        group.bench_function(BenchmarkId::new("part: one solve of K_stick + K_W", dof), |b| {
+            b.iter(|| lu.solve(black_box(&rhs)))
         });
     }
     group.finish();
