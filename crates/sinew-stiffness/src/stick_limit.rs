@@ -145,30 +145,45 @@ fn along(
 ) -> Result<StickLoadLimit, StiffnessError> {
     let mut best = (f64::INFINITY, None);
     let mut at_once = Vec::new();
-    for h in holes {
-        // δT per unit α of the two segments: spring times stretch (the free length's is 0).
-        let rate = |s: usize, spring: f64| -> Result<f64, StiffnessError> {
-            if s == 0 {
-                return Ok(0.0);
-            }
-            Ok(spring * dot(&friction.segment_jacobian(model, h.cable, s)?, &dq))
+    // The holes come cable by cable, hole by hole ([`holes`]): walk each cable's segments
+    // (read once per cable) in step, segment `k` before hole `k` and `k + 1` after it.
+    let mut pending = holes.iter();
+    for c in 0..model.cable_count() {
+        let mut segments = friction.segments(model, c)?.enumerate();
+        let Some((_, mut before)) = segments.next() else {
+            continue;
         };
-        let dt_k = rate(h.hole, h.springs[0])?;
-        let dt_next = rate(h.hole + 1, h.springs[1])?;
-        let dtheta = dot(&friction.wrap_gradient(model, h.cable, h.hole)?, &dq);
-        for edge in [BandEdge::Lower, BandEdge::Upper] {
-            let (a, b, d) = h.rate_coefficients(edge);
-            let dg = a * dt_next + b * dt_k + d * dtheta;
-            let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
-            if dg >= -RATE_TOLERANCE * terms {
-                continue;
+        for (s, after) in segments {
+            let h = match pending.next() {
+                Some(h) if (h.cable, h.hole + 1) == (c, s) => h,
+                _ => {
+                    let expected = holes.len();
+                    let what = "holes (cable by cable, in order)";
+                    return Err(StiffnessError::DimensionMismatch { what, expected, got: s });
+                }
+            };
+            // δT per unit α of the two segments: spring times stretch (the free length's is 0).
+            let rate = |segment: &sinew_routing::SegmentRows<'_>, k: usize, spring: f64| {
+                if k == 0 { 0.0 } else { spring * dot(&segment.jacobian, &dq) }
+            };
+            let dt_k = rate(&before, s - 1, h.springs[0]);
+            let dt_next = rate(&after, s, h.springs[1]);
+            let dtheta = dot(&before.wrap_gradient, &dq);
+            for edge in [BandEdge::Lower, BandEdge::Upper] {
+                let (a, b, d) = h.rate_coefficients(edge);
+                let dg = a * dt_next + b * dt_k + d * dtheta;
+                let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
+                if dg >= -RATE_TOLERANCE * terms {
+                    continue;
+                }
+                let g = h.room(edge);
+                if g <= EDGE_TOLERANCE * h.scale() {
+                    at_once.push(h.event(edge));
+                } else if g / -dg < best.0 {
+                    best = (g / -dg, Some(h.event(edge)));
+                }
             }
-            let g = h.room(edge);
-            if g <= EDGE_TOLERANCE * h.scale() {
-                at_once.push(h.event(edge));
-            } else if g / -dg < best.0 {
-                best = (g / -dg, Some(h.event(edge)));
-            }
+            before = after;
         }
     }
     let (magnitude, first) = match at_once.first() {

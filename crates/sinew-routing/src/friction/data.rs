@@ -37,6 +37,9 @@ pub struct SegmentRows<'a> {
     pub jacobian: DofRow<'a>,
     /// `∂w_s/∂Q` ([`FrictionData::weight_gradient`]; `None` before the weights).
     pub weight_gradient: Option<DofRow<'a>>,
+    /// `∂θ_s/∂Q` of hole `s`, where the segment ends ([`FrictionData::wrap_gradient`]; empty
+    /// for the anchor, which has no wrap angle).
+    pub wrap_gradient: DofRow<'a>,
     /// The routing segment it is (`None` for segment 0, the free length): its Hessian block is
     /// `H_s` over [`SegmentRows::jacobian`]'s DOFs ([`crate::SegmentHessians::get`]).
     pub routing_segment: Option<usize>,
@@ -210,6 +213,7 @@ impl FrictionData {
             weight: weighted.then(|| self.weights[e]),
             jacobian: row(&self.jacobians, &entry.jacobian),
             weight_gradient: weighted.then(|| row(&self.weight_gradients, &entry.weight)),
+            wrap_gradient: row(&self.wrap_gradients, &entry.wrap),
             routing_segment: entry.routing,
         }))
     }
