@@ -14,27 +14,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, non_snake_case)]
 
 use faer::Mat;
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use sinew_robot::RobotData;
 use sinew_routing::{Order, PatternModel, Routing, RoutingData, compute_cable_geometry};
 use sinew_testkit::cdhrm5;
 use sinew_testkit::config::{random_q, rng};
 use sinew_testkit::numeric::{H, max_abs, max_diff_and_scale};
+use sinew_testkit::one_joint::eq1;
 use sinew_testkit::random_chain::RandomChain;
-
-/// eq. (1): `T = Trans(0,0,d1) · Rot(x, q1) · Rot(y, q2) · Trans(0,0,d2)`.
-fn eq1(d1: f64, d2: f64, q1: f64, q2: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(Translation3::new(0.0, 0.0, d1), UnitQuaternion::identity())
-        * Isometry3::from_parts(
-            Translation3::identity(),
-            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), q1),
-        )
-        * Isometry3::from_parts(
-            Translation3::identity(),
-            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), q2),
-        )
-        * Isometry3::from_parts(Translation3::new(0.0, 0.0, d2), UnitQuaternion::identity())
-}
 
 /// eq. (2): `|r_j − T · r'_j|`, `r_j` in `O_i`, `r'_j` in `O'_i`.
 fn eq2(r: Vector3<f64>, r_prime: Vector3<f64>, T: &Isometry3<f64>) -> f64 {
@@ -58,7 +45,7 @@ fn one_joint_length_is_eq_2() {
         let q = random_q(&robot, &mut rng);
         compute_cable_geometry(&routing, &robot, &mut rdata, &mut data, &q, Order::Lengths)
             .unwrap();
-        let T = eq1(chain.d1, chain.d2, q[0], q[1]);
+        let T = eq1(chain.d1, chain.d2, [q[0], q[1]]);
         for k in 0..3 {
             let theta = cdhrm5::THETA0 + std::f64::consts::TAU * k as f64 / 3.0;
             let r = Vector3::new(rho * theta.cos(), rho * theta.sin(), 0.0);
@@ -91,7 +78,7 @@ fn every_cdhrm5_joint_length_is_eq_2() {
             let i = cable.joint;
             assert_eq!(cable.holes.len(), 2);
             // d1 = 30 mm, d2 = 0: the calibrated platform (robots/cdhrm5/README.md).
-            let T = eq1(0.03, 0.0, q[2 * i], q[2 * i + 1]);
+            let T = eq1(0.03, 0.0, [q[2 * i], q[2 * i + 1]]);
             let expected = eq2(cable.holes[0].point, cable.holes[1].point, &T);
             let got = data.lengths().unwrap()[c];
             assert!((got - expected).abs() <= 1e-14, "{}: {got} vs eq. (2) {expected}", cable.name);

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use sinew_testkit::cdhrm5;
+use sinew_testkit::one_joint::HEADER;
 
 use proptest::prelude::*;
 use sinew_robot::{ChainSettings, Robot, RobotData};
@@ -11,14 +12,6 @@ use sinew_routing::{
 };
 
 const FILE: &str = "test/cables.toml";
-
-const HEADER: &str = r#"
-tension_limits = [20.0, 600.0]
-free_length = 1.0
-[material]
-youngs_modulus = 12.5e9
-diameter = 1.0e-3
-"#;
 
 /// An explicit routing: the header then the given cables.
 fn explicit(cables: &str) -> String {

@@ -3,7 +3,7 @@
 //! the friction stages' own errors.
 #![allow(clippy::unwrap_used, clippy::expect_used, non_snake_case)]
 
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
 use sinew_robot::{ErrorKind, Robot, RobotData};
 use sinew_routing::{
     FrictionData, FrictionModel, Order, Routing, RoutingData, RoutingError, Slip,
@@ -11,17 +11,10 @@ use sinew_routing::{
 };
 use sinew_testkit::cdhrm5;
 use sinew_testkit::config::random_qs;
+use sinew_testkit::one_joint::{HEADER, eq1, one_hole_routing};
 use sinew_testkit::random_chain::RandomChain;
 
 const FILE: &str = "test/cables.toml";
-
-const HEADER: &str = r#"
-tension_limits = [20.0, 600.0]
-free_length = 1.0
-[material]
-youngs_modulus = 12.5e9
-diameter = 1.0e-3
-"#;
 
 const PATTERN: &str = r#"
 [pattern]
@@ -210,20 +203,6 @@ fn bad_friction_input_is_a_typed_error_naming_the_file_and_the_cable() {
     }
 }
 
-/// eq. (1): `T = Trans(0,0,d1) · Rot(x, q1) · Rot(y, q2) · Trans(0,0,d2)`.
-fn eq1(d1: f64, d2: f64, q1: f64, q2: f64) -> Isometry3<f64> {
-    let rot = |axis, angle| {
-        Isometry3::from_parts(
-            Translation3::identity(),
-            UnitQuaternion::from_axis_angle(axis, angle),
-        )
-    };
-    Isometry3::translation(0.0, 0.0, d1)
-        * rot(&Vector3::x_axis(), q1)
-        * rot(&Vector3::y_axis(), q2)
-        * Isometry3::translation(0.0, 0.0, d2)
-}
-
 #[test]
 fn one_hole_matches_the_closed_form_capstan_ratio() {
     // One universal joint; a cable from a hole on the base disc to its anchor on the distal
@@ -233,10 +212,7 @@ fn one_hole_matches_the_closed_form_capstan_ratio() {
     let robot: Robot = chain.build().unwrap();
     let (rho, alpha, mu) = (0.02, 0.3_f64, 0.35);
     let entry = Vector3::new(alpha.sin(), 0.0, alpha.cos());
-    let text = format!(
-        "{HEADER}[[cable]]\nname = \"one\"\nfriction_coefficient = {mu}\nentry_direction = [{}, 0.0, {}]\nholes = [{{ link = \"base_link\", point = [{rho}, 0.0, 0.0] }}, {{ link = \"link1\", point = [{rho}, 0.0, 0.0] }}]\n",
-        entry.x, entry.z
-    );
+    let text = one_hole_routing(rho, mu, &entry);
     let routing = Routing::from_toml_str(&text, FILE, &robot).unwrap();
     let model = FrictionModel::new(&routing);
     let mut rdata = RobotData::new(&robot);
@@ -250,7 +226,7 @@ fn one_hole_matches_the_closed_form_capstan_ratio() {
             .unwrap();
         compute_friction_geometry(&model, &routing, &routing_data, &mut data).unwrap();
         let r = Vector3::new(rho, 0.0, 0.0);
-        let u = (eq1(chain.d1, chain.d2, q[0], q[1]) * Point3::from(r)).coords - r;
+        let u = (eq1(chain.d1, chain.d2, [q[0], q[1]]) * Point3::from(r)).coords - r;
         let theta = entry.cross(&u).norm().atan2(entry.dot(&u));
         let angles = data.wrap_angles(&model, 0).unwrap();
         assert_eq!(angles.len(), 1);

@@ -18,9 +18,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use faer::Mat;
-use nalgebra::{
-    Isometry3, Matrix2, Point3, Translation3, UnitQuaternion, Vector2, Vector3, Vector6,
-};
+use nalgebra::{Matrix2, Point3, Vector2, Vector3, Vector6};
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{
     FrictionData, FrictionModel, Order, Routing, RoutingData, Slip, compute_cable_geometry,
@@ -28,28 +26,7 @@ use sinew_routing::{
 };
 use sinew_stiffness::{FrictionStiffnessData, History, directional_response, stick_stiffness};
 use sinew_testkit::cdhrm5;
-
-const HEADER: &str = r#"
-tension_limits = [20.0, 600.0]
-free_length = 1.0
-[material]
-youngs_modulus = 12.5e9
-diameter = 1.0e-3
-"#;
-
-/// eq. (1): `T = Trans(0,0,d1) · Rot(x, q1) · Rot(y, q2) · Trans(0,0,d2)`.
-fn eq1(d1: f64, d2: f64, q: [f64; 2]) -> Isometry3<f64> {
-    let rot = |axis, angle| {
-        Isometry3::from_parts(
-            Translation3::identity(),
-            UnitQuaternion::from_axis_angle(axis, angle),
-        )
-    };
-    Isometry3::translation(0.0, 0.0, d1)
-        * rot(&Vector3::x_axis(), q[0])
-        * rot(&Vector3::y_axis(), q[1])
-        * Isometry3::translation(0.0, 0.0, d2)
-}
+use sinew_testkit::one_joint::{eq1, one_hole_routing};
 
 #[test]
 fn a_single_holes_directional_stiffness_is_the_closed_form() {
@@ -57,10 +34,7 @@ fn a_single_holes_directional_stiffness_is_the_closed_form() {
     let robot: Robot = chain.build().unwrap();
     let (rho, alpha, mu, t0) = (0.02, 0.3_f64, 0.2, 150.0);
     let entry = Vector3::new(alpha.sin(), 0.0, alpha.cos());
-    let text = format!(
-        "{HEADER}[[cable]]\nname = \"one\"\nfriction_coefficient = {mu}\nentry_direction = [{}, 0.0, {}]\nholes = [{{ link = \"base_link\", point = [{rho}, 0.0, 0.0] }}, {{ link = \"link1\", point = [{rho}, 0.0, 0.0] }}]\n",
-        entry.x, entry.z
-    );
+    let text = one_hole_routing(rho, mu, &entry);
     let routing = Routing::from_toml_str(&text, "test/cables.toml", &robot).unwrap();
     let model = FrictionModel::new(&routing);
     let ea = 12.5e9 * std::f64::consts::PI * 1.0e-3_f64.powi(2) / 4.0;

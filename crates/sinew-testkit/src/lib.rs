@@ -11,7 +11,9 @@
 //! - [`random_chain`]: seeded random-geometry chains (random rpy, axes, offsets, inertials)
 //!   with their link poses computed independently and pattern or explicit routings;
 //! - [`numeric`]: the relative-error measures and the central-difference helpers that check
-//!   every analytic derivative.
+//!   every analytic derivative;
+//! - [`one_joint`]: the paper's joint transform (eq. 1) and explicit one-joint routings, the
+//!   closed-form fixtures.
 //!
 //! The E4 pose is not here: its one owner is the experiment layer, `sinew::paper::E4_Q` and
 //! `E4_F0` in the facade, which this crate must not depend on (the facade depends on every
@@ -27,4 +29,5 @@ pub mod cdhrm5;
 pub mod config;
 pub mod newton;
 pub mod numeric;
+pub mod one_joint;
 pub mod random_chain;
