@@ -125,6 +125,17 @@ fn cholesky_dynamic(a: &mut [f64], n: usize) -> bool {
     true
 }
 
+/// Solve `L w = b` in place (`l` from [`cholesky`]) for a `b` that is zero before `start`:
+/// `w` is too, and the substitution starts there.
+#[inline(always)]
+pub(crate) fn forward_solve_from(l: &[f64], n: usize, b: &mut [f64], start: usize) {
+    let b = &mut b[..n];
+    for i in start..n {
+        let row = &l[i * n + start..i * n + i];
+        b[i] = (b[i] - dot(row, &b[start..i])) / l[i * n + i];
+    }
+}
+
 /// Solve `L Lᵀ x = b` in place (`l` from [`cholesky`]): forward by rows of `L`, backward by
 /// the same rows (`Lᵀ`'s columns); fixed-size kernels up to n = 17.
 #[inline(always)]

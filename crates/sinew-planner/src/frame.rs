@@ -32,6 +32,9 @@ pub(crate) struct Frame {
     pub(crate) a0: Vec<f64>,
     /// `∂A/∂x_a = w_a A_i`, one per free coordinate.
     pub(crate) ai: Vec<Vec<f64>>,
+    /// The rows and columns where each `∂A/∂x_a` can be non-zero ([`Pencil::spans`]): a
+    /// decoupled joint's 2 × 2 block, a routed cable's DOFs from the base to its anchor.
+    pub(crate) spans: Vec<Range<usize>>,
     /// A stiffness scale of the pencil (its largest diagonal entry at `x = 0`), N m/rad.
     pub(crate) a_scale: f64,
     /// `J_x`, 6 × n row-major.
@@ -105,6 +108,7 @@ impl Frame {
                 symmetric(a, span(i), *l, &mut a0);
             }
         }
+        let spans: Vec<Range<usize>> = free.iter().map(|&i| span(i)).collect();
         let ai: Vec<Vec<f64>> = free
             .iter()
             .zip(&width)
@@ -143,7 +147,7 @@ impl Frame {
             + column_sums.iter().zip(&base).map(|(a, b)| a * b).sum::<f64>();
         let sums = free.iter().zip(&width).map(|(&i, w)| column_sums[i] * w).collect();
         debug_assert_eq!(rows.len(), rhs.len() * k);
-        Frame { n, free, base, width, a0, ai, a_scale, j_x, rows, rhs, total, sums }
+        Frame { n, free, base, width, a0, ai, spans, a_scale, j_x, rows, rhs, total, sums }
     }
 
     /// Free coordinates.
@@ -167,10 +171,14 @@ impl Frame {
 
     /// `A(x)` into `out` (n × n).
     pub(crate) fn a_at(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.n;
         out.copy_from_slice(&self.a0);
-        for (v, a) in x.iter().zip(&self.ai) {
-            for (o, e) in out.iter_mut().zip(a) {
-                *o += v * e;
+        for ((v, a), span) in x.iter().zip(&self.ai).zip(&self.spans) {
+            for r in span.clone() {
+                let (o, e) = (&mut out[r * n..r * n + n], &a[r * n..r * n + n]);
+                for (o, e) in o[span.clone()].iter_mut().zip(&e[span.clone()]) {
+                    *o += v * e;
+                }
             }
         }
     }

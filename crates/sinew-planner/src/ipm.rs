@@ -25,13 +25,18 @@ use crate::smooth::{EndObjective, Kind};
 /// start well inside the margin and the floors, not on their boundary.
 const CENTRING: f64 = 0.3;
 
+/// Above this many DOFs the last phase checks the margin lazily ([`Interior::optimise`]): up to
+/// it, the fixed-size kernels make the margin's block cheap.
+pub(crate) const LAZY_MARGIN_DOF: usize = 16;
+
 /// One plan's interior-point problem.
 pub(crate) struct Interior<'a> {
     pub(crate) frame: &'a Frame,
     pub(crate) objective: Objective,
     pub(crate) requirements: &'a Requirements,
     pub(crate) settings: &'a PlanSettings,
-    /// `R` (n × (n − 3)), when `J_r` has rank 3.
+    /// `R` (n × (n − 3)), when `J_r` has rank 3 and a floor block needs it (`None` when
+    /// none does).
     pub(crate) rotation_null: Option<Vec<f64>>,
     /// A warm start: epigraph variables start just inside their block, not halfway.
     pub(crate) warm: bool,
@@ -58,7 +63,11 @@ impl<'a> Interior<'a> {
             objective,
             requirements,
             settings,
-            rotation_null: frame.rotation_null_basis(),
+            rotation_null: (matches!(objective, Objective::MinStiffness)
+                || requirements.k_min.is_some()
+                || requirements.k_des.is_some())
+            .then(|| frame.rotation_null_basis())
+            .flatten(),
             warm: false,
         }
     }
@@ -190,9 +199,18 @@ impl<'a> Interior<'a> {
         out
     }
 
-    /// The margin and the floors met so far as fixed blocks, with `extra` columns.
-    fn constraint_blocks(&self, floors: usize, extra: usize) -> Result<Vec<Block>, PlanError> {
-        let mut blocks = vec![margin_block(self.frame, self.requirements.margin, extra, None)];
+    /// The margin (unless `lazy`) and the floors met so far as fixed blocks, with `extra`
+    /// columns.
+    fn constraint_blocks(
+        &self,
+        floors: usize,
+        extra: usize,
+        lazy: bool,
+    ) -> Result<Vec<Block>, PlanError> {
+        let mut blocks = Vec::new();
+        if !lazy {
+            blocks.push(margin_block(self.frame, self.requirements.margin, extra, None));
+        }
         for (floor, tau, _) in self.floors().into_iter().take(floors) {
             blocks.push(
                 floor_block(self.frame, self.rotation_null.as_ref(), floor, Ok(tau), extra)
@@ -226,7 +244,7 @@ impl<'a> Interior<'a> {
             }
             let scale = now.abs().max(tau.abs()).max(1e-12);
             let mut sdp = base(self.frame, 1);
-            sdp.blocks = self.constraint_blocks(index, 1)?;
+            sdp.blocks = self.constraint_blocks(index, 1, false)?;
             let epigraph =
                 floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
                     .ok_or(PlanError::NoEndStiffness)?;
@@ -256,12 +274,43 @@ impl<'a> Interior<'a> {
         Ok((x, iterations))
     }
 
-    /// The last phase: the objective from `x` meeting every requirement. The returned bound is in real units of the maximised objective (`−Σ f`,
-    /// `−uᵀ C u` for the minimised ones).
+    /// The last phase: the objective from `x` meeting every requirement. The returned bound is
+    /// in real units of the maximised objective (`−Σ f`, `−uᵀ C u` for the minimised ones).
+    ///
+    /// Above [`LAZY_MARGIN_DOF`] DOFs the margin is checked lazily, as the margin rarely binds
+    /// where the objective asks for stiffness and its n × n block dominates an iteration: the
+    /// phase first runs without the margin's block, and its answer stands when `A − m I ≻ 0`
+    /// there (one Cholesky trial). The bound of that run holds for the plan's problem too: it
+    /// bounds the optimum over a larger set (the objective is concave on its domain `A ≻ 0`,
+    /// which the run never leaves: its steps are halved where they would). Otherwise the phase
+    /// runs again from `x` with the block, and both runs' iterations count.
     ///
     /// # Errors
     /// [`PlanError::NoEndStiffness`]; [`PlanError::NotConverged`].
     pub(crate) fn optimise(&self, x: &[f64], max_iterations: usize) -> Result<Answer, PlanError> {
+        if self.frame.n <= LAZY_MARGIN_DOF {
+            return self.optimise_blocks(x, max_iterations, false);
+        }
+        let spent = match self.optimise_blocks(x, max_iterations, true) {
+            Ok(answer) if self.margin_exceeds(&answer.x, self.requirements.margin) => {
+                return Ok(answer);
+            }
+            Ok(answer) => answer.iterations,
+            Err(PlanError::NotConverged { iterations, .. }) => iterations,
+            Err(PlanError::NoEndStiffness) => 0,
+            Err(other) => return Err(other),
+        };
+        let answer = self.optimise_blocks(x, max_iterations, false)?;
+        Ok(Answer { iterations: answer.iterations + spent, ..answer })
+    }
+
+    /// [`Self::optimise`]'s run, with the margin's block unless `lazy`.
+    fn optimise_blocks(
+        &self,
+        x: &[f64],
+        max_iterations: usize,
+        lazy: bool,
+    ) -> Result<Answer, PlanError> {
         let f = self.frame;
         let k = f.vars();
         let gap = self.settings.relative_gap;
@@ -271,7 +320,7 @@ impl<'a> Interior<'a> {
         let (run, scale) = match self.objective {
             Objective::LeastTension => {
                 let mut sdp = base(self.frame, 0);
-                sdp.blocks = self.constraint_blocks(floors, 0)?;
+                sdp.blocks = self.constraint_blocks(floors, 0, lazy)?;
                 let total = f.total + f.sums.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
                 let scale = total.abs().max(1e-9);
                 sdp.c0 = -f.total / scale;
@@ -280,7 +329,7 @@ impl<'a> Interior<'a> {
             }
             Objective::StiffnessAlong(_) | Objective::Volume => {
                 let mut sdp = base(self.frame, 0);
-                sdp.blocks = self.constraint_blocks(floors, 0)?;
+                sdp.blocks = self.constraint_blocks(floors, 0, lazy)?;
                 let kind = match self.objective {
                     Objective::StiffnessAlong(u) => {
                         Kind::Along(Vector6::new(u.x, u.y, u.z, 0., 0., 0.))
@@ -308,7 +357,7 @@ impl<'a> Interior<'a> {
                 let now = self.floor_value(x, &floor).ok_or(PlanError::NoEndStiffness)?;
                 let scale = now.abs().max(1e-12);
                 let mut sdp = base(self.frame, 1);
-                sdp.blocks = self.constraint_blocks(floors, 1)?;
+                sdp.blocks = self.constraint_blocks(floors, 1, lazy)?;
                 sdp.blocks.push(
                     floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
                         .ok_or(PlanError::NoEndStiffness)?,
@@ -326,7 +375,7 @@ impl<'a> Interior<'a> {
                     .ok_or_else(|| self.no_stable_tensions(f64::NEG_INFINITY))?;
                 let scale = c.abs().max(1e-300);
                 let mut sdp = base(self.frame, 1);
-                sdp.blocks = self.constraint_blocks(floors, 1)?;
+                sdp.blocks = self.constraint_blocks(floors, 1, lazy)?;
                 sdp.blocks.push(compliance_block(self.frame, &u, scale));
                 sdp.c[k] = -1.0;
                 sdp.epigraph = Some((k, sdp.blocks.len() - 1));

@@ -23,6 +23,10 @@ use crate::dense::{axpy, cholesky, cholesky_inverse, cholesky_solve, dot, inner}
 pub(crate) use crate::program::{Block, Duals, End, Run, Sdp, Settings, Smooth};
 use crate::program::{centred_duals, upper_bound};
 
+/// How often a step that leaves the smooth objective's domain is halved before the run
+/// breaks down.
+const MAX_HALVINGS: usize = 30;
+
 /// The vectors of a run (rows, variables), allocated once per run.
 struct Vectors {
     s: Vec<f64>,
@@ -37,6 +41,8 @@ struct Vectors {
     dy: Vec<f64>,
     ds_aff_row: Vec<f64>,
     dy_aff: Vec<f64>,
+    /// `x` before the last step.
+    previous: Vec<f64>,
 }
 
 impl Vectors {
@@ -54,6 +60,7 @@ impl Vectors {
             dy: vec![0.0; p],
             ds_aff_row: vec![0.0; p],
             dy_aff: vec![0.0; p],
+            previous: vec![0.0; k],
         }
     }
 }
@@ -106,30 +113,45 @@ fn solve_body<'s>(
     let mut duals = Duals::default();
     let mut best: Option<(f64, f64)> = None;
     let run = |x: Vec<f64>, value, upper, iterations, end| Run { x, value, upper, iterations, end };
+    // The last primal step's length: where the step leaves the smooth objective's domain
+    // (which no block bounds when the margin is checked lazily, `ipm.rs`), it is halved.
+    let mut last_step: Option<f64> = None;
     for iteration in 0..=settings.max_iterations {
-        // The slacks, their factors and inverses, the objective.
-        sdp.slacks(&x, &mut v.s);
-        let mut interior = v.s.iter().all(|s| *s > 0.0);
-        for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
-            b.at(&x, &mut w.s);
-            w.l.copy_from_slice(&w.s);
-            interior &= cholesky(&mut w.l, b.n);
-            if interior {
-                cholesky_inverse(&w.l, b.n, &mut w.s_inv, &mut w.t1);
-            }
-        }
-        v.gradient.copy_from_slice(&sdp.c);
-        v.hessian.fill(0.0);
-        let mut value = sdp.c0 + dot(&sdp.c, &x);
-        if let Some(smooth) = smooth.as_deref_mut() {
-            match smooth.evaluate(&x, &mut v.smooth_gradient, &mut v.hessian) {
-                Some(psi) => {
-                    value += psi;
-                    axpy(1.0, &v.smooth_gradient, &mut v.gradient);
+        let mut halvings = 0;
+        let (value, interior) = loop {
+            // The slacks, their factors and inverses, the objective.
+            sdp.slacks(&x, &mut v.s);
+            let mut interior = v.s.iter().all(|s| *s > 0.0);
+            for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
+                b.at(&x, &mut w.s);
+                w.l.copy_from_slice(&w.s);
+                interior &= cholesky(&mut w.l, b.n);
+                if interior {
+                    cholesky_inverse(&w.l, b.n, &mut w.s_inv, &mut w.t1);
                 }
-                None => interior = false,
             }
-        }
+            v.gradient.copy_from_slice(&sdp.c);
+            v.hessian.fill(0.0);
+            let mut value = sdp.c0 + dot(&sdp.c, &x);
+            if let Some(smooth) = smooth.as_deref_mut() {
+                match smooth.evaluate(&x, &mut v.smooth_gradient, &mut v.hessian) {
+                    Some(psi) => {
+                        value += psi;
+                        axpy(1.0, &v.smooth_gradient, &mut v.gradient);
+                    }
+                    None => interior = false,
+                }
+            }
+            match last_step {
+                Some(alpha) if !interior && halvings < MAX_HALVINGS => {
+                    halvings += 1;
+                    last_step = Some(0.5 * alpha);
+                    x.copy_from_slice(&v.previous);
+                    axpy(0.5 * alpha, &v.dx, &mut x);
+                }
+                _ => break (value, interior),
+            }
+        };
         if !interior {
             let (value, upper) = best.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
             return run(x0.to_vec(), value, upper, iteration, End::Breakdown);
@@ -253,6 +275,8 @@ fn solve_body<'s>(
         let alpha_p = step_length(s, &v.ds_row, &mut works, |w| (&w.s, &w.ds));
         zs(&mut works, &duals);
         let alpha_d = step_length(&duals.y, &v.dy, &mut works, |w| (&w.t2, &w.dz));
+        v.previous.copy_from_slice(&x);
+        last_step = Some(alpha_p);
         axpy(alpha_p, &v.dx, &mut x);
         axpy(alpha_d, &v.dy, &mut duals.y);
         for (z, w) in duals.z.iter_mut().zip(&works) {

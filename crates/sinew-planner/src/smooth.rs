@@ -9,13 +9,17 @@
 //! - `φ = log det K_fd`, `K_fd = K_x[0:3, 0:3] = L Lᵀ`, `U = V[:, 0:3] L⁻ᵀ`,
 //!   `G_a = Uᵀ A_a U`: `∂_a φ = tr G_a`, `∂_ab φ = −⟨G_a, G_b⟩ − 2 ⟨A_a U, P A_b U⟩`.
 //!
+//! With `A = L Lᵀ`, the Hessians' cross terms are `(A_a z)ᵀ P (A_b z) = w_aᵀ w_b − t_aᵀ K_x t_b`,
+//! `w_a = L⁻¹ A_a z` (a forward substitution from the first row where `A_a` is not zero) and
+//! `t_a = Yᵀ A_a z`: no full solve per coefficient.
+//!
 //! Both Hessians are `⪯ 0` (Gram forms with `P ⪰ 0`): the objectives are concave, as
 //! `wᵀ K_x w = min { δqᵀ A δq : J_x δq = w }` is a minimum of affine functions of `x`.
 
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use sinew_stiffness::compliance_inverse;
 
-use crate::dense::{axpy, cholesky, cholesky_solve, dot};
+use crate::dense::{axpy, cholesky, cholesky_solve, dot, forward_solve_from};
 use crate::frame::Frame;
 use crate::sdp::Smooth;
 
@@ -40,13 +44,15 @@ pub(crate) struct EndObjective<'a> {
     a: Vec<f64>,
     /// `Yᵀ = J_x A⁻¹` (6 × n).
     yt: Vec<f64>,
-    /// The rows of each `A_a` that are not zero.
-    supports: Vec<Vec<usize>>,
+    /// The rows of each `A_a` that can be non-zero (the frame's spans).
+    supports: Vec<std::ops::Range<usize>>,
     /// `z_j` (c × n).
     zs: Vec<f64>,
-    /// `A_a z_j` and `P A_a z_j` (k × c × n).
+    /// `A_a z_j` and `L⁻¹ A_a z_j` (k × c × n).
     az: Vec<f64>,
-    pa: Vec<f64>,
+    la: Vec<f64>,
+    /// `Yᵀ A_a z_j` (k × c × 6).
+    ta: Vec<f64>,
     /// `G_a = zsᵀ A_a zs` (k × c × c).
     g: Vec<f64>,
 }
@@ -59,11 +65,7 @@ pub(crate) struct EndAt {
 impl<'a> EndObjective<'a> {
     pub(crate) fn new(frame: &'a Frame, kind: Kind, scale: f64) -> EndObjective<'a> {
         let (n, k) = (frame.n, frame.vars());
-        let supports = frame
-            .ai
-            .iter()
-            .map(|a| (0..n).filter(|r| a[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect())
-            .collect();
+        let supports = frame.spans.clone();
         EndObjective {
             frame,
             kind,
@@ -73,7 +75,8 @@ impl<'a> EndObjective<'a> {
             supports,
             zs: vec![0.0; 3 * n],
             az: vec![0.0; k * 3 * n],
-            pa: vec![0.0; k * 3 * n],
+            la: vec![0.0; k * 3 * n],
+            ta: vec![0.0; k * 3 * 6],
             g: vec![0.0; k * 9],
         }
     }
@@ -95,19 +98,6 @@ impl<'a> EndObjective<'a> {
         let c_x = 0.5 * (c_x + c_x.transpose());
         let k_x = compliance_inverse(&c_x).ok()?;
         Some(EndAt { k_x: 0.5 * (k_x + k_x.transpose()) })
-    }
-
-    /// `P v` into `out` for the factor in `self.a` (after [`Self::end_at`]):
-    /// `A⁻¹ v − Y K_x Yᵀ v`.
-    fn p_times(a: &[f64], yt: &[f64], k_x: &Matrix6<f64>, v: &[f64], out: &mut [f64]) {
-        let n = v.len();
-        out.copy_from_slice(v);
-        cholesky_solve(a, n, out);
-        let ytv = Vector6::from_fn(|j, _| dot(&yt[j * n..j * n + n], v));
-        let kv = k_x * ytv;
-        for (j, row) in yt.chunks_exact(n).enumerate() {
-            axpy(-kv[j], row, out);
-        }
     }
 
     /// `z_j = Y K_x m_j` for the 6-vectors `columns` into `self.zs`.
@@ -140,8 +130,8 @@ impl<'a> EndObjective<'a> {
             for (j, z) in zs.chunks_exact(n).enumerate() {
                 let out = &mut self.az[(a * c + j) * n..(a * c + j + 1) * n];
                 out.fill(0.0);
-                for &r in rows {
-                    out[r] = dot(&ai[r * n..r * n + n], z);
+                for r in rows.clone() {
+                    out[r] = dot(&ai[r * n..r * n + n][rows.clone()], &z[rows.clone()]);
                 }
             }
         }
@@ -150,7 +140,9 @@ impl<'a> EndObjective<'a> {
             let mut trace = 0.0;
             for i in 0..c {
                 for j in 0..c {
-                    let v = dot(&zs[i * n..i * n + n], &self.az[(a * c + j) * n..][..n]);
+                    let rows = self.supports[a].clone();
+                    let z = &zs[i * n..i * n + n][rows.clone()];
+                    let v = dot(z, &self.az[(a * c + j) * n..][..n][rows]);
                     self.g[a * c * c + i * c + j] = v;
                     if i == j {
                         trace += v;
@@ -159,14 +151,29 @@ impl<'a> EndObjective<'a> {
             }
             gradient[a] = trace;
         }
-        // P A_b z_j.
-        for (az, pa) in self.az[..k * c * n].chunks_exact(n).zip(self.pa.chunks_exact_mut(n)) {
-            Self::p_times(&self.a, &self.yt, k_x, az, pa);
+        // L⁻¹ A_a z_j from the span's first row, and Yᵀ A_a z_j over the span.
+        for (a, rows) in self.supports.iter().enumerate() {
+            for j in 0..c {
+                let at = (a * c + j) * n;
+                let (az, la) = (&self.az[at..at + n], &mut self.la[at..at + n]);
+                la.copy_from_slice(az);
+                forward_solve_from(&self.a, n, la, rows.start.min(n));
+                for (i, y) in self.yt.chunks_exact(n).enumerate() {
+                    self.ta[(a * c + j) * 6 + i] = dot(&y[rows.clone()], &az[rows.clone()]);
+                }
+            }
         }
         for a in 0..k {
             for b in a..k {
-                let cross =
-                    dot(&self.az[a * c * n..(a + 1) * c * n], &self.pa[b * c * n..(b + 1) * c * n]);
+                let from = self.supports[a].start.max(self.supports[b].start).min(n);
+                let mut cross = 0.0;
+                for j in 0..c {
+                    let (ra, rb) = ((a * c + j) * n, (b * c + j) * n);
+                    cross += dot(&self.la[ra + from..ra + n], &self.la[rb + from..rb + n]);
+                    let ta = Vector6::from_column_slice(&self.ta[(a * c + j) * 6..][..6]);
+                    let tb = Vector6::from_column_slice(&self.ta[(b * c + j) * 6..][..6]);
+                    cross -= ta.dot(&(k_x * tb));
+                }
                 let gg = if volume {
                     dot(&self.g[a * c * c..(a + 1) * c * c], &self.g[b * c * c..(b + 1) * c * c])
                 } else {
