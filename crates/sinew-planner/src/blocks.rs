@@ -50,7 +50,7 @@ pub(crate) fn margin_block(f: &Frame, shift: f64, extra: usize, epigraph: Option
         constant[i * n + i] -= shift * s;
     }
     let mut coefficients: Vec<Option<Vec<f64>>> =
-        f.ai.iter().map(|a| Some(a.iter().map(|v| v * s).collect())).collect();
+        (0..f.vars()).map(|a| Some(f.ai_dense(a, s))).collect();
     coefficients.extend(std::iter::repeat_n(None, extra));
     if let Some(t_scale) = epigraph {
         let mut d = vec![0.0; n * n];
@@ -92,7 +92,7 @@ pub(crate) fn floor_block(
     let fixed = tau.unwrap_or(0.0);
     let constant: Vec<f64> = b0.iter().zip(&d).map(|(b, dd)| (b - fixed * dd) * s).collect();
     let mut coefficients: Vec<Option<Vec<f64>>> =
-        f.ai.iter().map(|a| Some(congruence(a, r, n, p).iter().map(|v| v * s).collect())).collect();
+        (0..f.vars()).map(|a| Some(congruence(&f.ai_dense(a, s), r, n, p))).collect();
     coefficients.extend(std::iter::repeat_n(None, extra));
     if let Err(t_scale) = tau {
         coefficients[f.vars()] = Some(d.iter().map(|v| -t_scale * v * s).collect());
@@ -116,18 +116,13 @@ pub(crate) fn compliance_block(f: &Frame, u: &nalgebra::Vector3<f64>, s_scale: f
         constant[r * m + n] = b * cross;
         constant[n * m + r] = b * cross;
     }
-    let mut coefficients: Vec<Option<Vec<f64>>> =
-        f.ai.iter()
-            .map(|a| {
-                let mut e = vec![0.0; m * m];
-                for r in 0..n {
-                    for c in 0..n {
-                        e[r * m + c] = a[r * n + c] * sa;
-                    }
-                }
-                Some(e)
-            })
-            .collect();
+    let mut coefficients: Vec<Option<Vec<f64>>> = (0..f.vars())
+        .map(|a| {
+            let mut e = vec![0.0; m * m];
+            f.add_ai(a, sa, &mut e, m);
+            Some(e)
+        })
+        .collect();
     let mut d = vec![0.0; m * m];
     d[n * m + n] = 1.0;
     coefficients.push(Some(d));

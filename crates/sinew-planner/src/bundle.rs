@@ -90,20 +90,31 @@ impl Linear {
     pub(crate) fn merged(&self) -> Linear {
         let k = self.k;
         let mut out = Linear::new(k, self.rhs.len());
+        // Each kept row's first coordinate above `KEY` (rows scaled to a largest entry of 1):
+        // only rows with the same key are compared in full. Rows within 1e-12 of each other
+        // share it unless an entry lies within 1e-12 of `KEY`, and then they are both kept,
+        // which leaves the polytope as it is.
+        const KEY: f64 = 1e-6;
+        let mut keys: Vec<usize> = Vec::with_capacity(self.rhs.len());
         for (row, rhs) in self.rows().zip(&self.rhs) {
             let scale = row.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             if scale == 0.0 {
                 // 0 ≤ rhs: keep it (an infeasible one proves infeasibility).
                 out.push(row.iter().copied(), *rhs);
+                keys.push(usize::MAX);
                 continue;
             }
             let b = rhs / scale;
-            let same = out
-                .rows()
-                .position(|r| r.iter().zip(row).all(|(x, y)| (x - y / scale).abs() <= 1e-12));
+            let key = row.iter().position(|v| v.abs() > KEY * scale).unwrap_or(k);
+            let same = out.rows().zip(&keys).position(|(r, kr)| {
+                *kr == key && r.iter().zip(row).all(|(x, y)| (x - y / scale).abs() <= 1e-12)
+            });
             match same {
                 Some(i) => out.rhs[i] = out.rhs[i].min(b),
-                None => out.push(row.iter().map(|v| v / scale), b),
+                None => {
+                    out.push(row.iter().map(|v| v / scale), b);
+                    keys.push(key);
+                }
             }
         }
         out

@@ -1,6 +1,7 @@
 //! Unit checks of the interior-point method's parts on cdhrm5's pencils: the smooth
 //! objectives' gradients and Hessians against central differences (and `H ⪯ 0`), the
-//! certificate's soundness for random multipliers, and the method on a problem solved by hand.
+//! certificate's soundness for random multipliers, the method on a problem solved by hand, and
+//! the frame's compact coefficients against the pencil.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{DMatrix, Vector6};
@@ -199,4 +200,48 @@ fn the_method_finds_a_hand_solved_optimum_and_certifies_it() {
     assert_eq!(run.end, End::Optimum);
     assert!((run.x[0]).abs() <= 1e-8 && (run.value - 1.0).abs() <= 1e-9, "{:?}", run.x);
     assert!(run.upper >= 1.0 - 1e-12 && run.upper - run.value <= 1e-10);
+}
+
+/// The frame keeps each `∂A/∂x_a` as its square over the coefficient's span: `A(x)` from it is
+/// the pencil's `A(λ(x))` (symmetrised, every entry), in both models, and the form `vᵀ A_a v`
+/// and the dense copy agree with it. A span cut short, or a square placed at the wrong
+/// origin, fails it.
+#[test]
+fn the_frames_compact_coefficients_are_the_pencils() {
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut sd = ArmStiffnessData::new(&arm);
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
+        let set = arm.equilibrium_set(&mut sd).unwrap().clone();
+        arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
+        let mut pencil = crate::pencil::Pencil::empty();
+        pencil.fill(&arm, &mut sd, &set).unwrap();
+        let f = Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[]);
+        let n = f.n;
+        for _ in 0..5 {
+            let x: Vec<f64> = (0..f.vars()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let mut a = vec![0.0; n * n];
+            f.a_at(&x, &mut a);
+            let expected = pencil.at(&f.lambda(&x));
+            let size = (0..n).map(|i| expected[(i, i)].abs()).fold(0.0, f64::max);
+            for r in 0..n {
+                for c in 0..n {
+                    let d = (a[r * n + c] - expected[(r, c)]).abs();
+                    assert!(d <= 1e-12 * size, "{model:?}: A({r}, {c}) off by {d:e}");
+                }
+            }
+            let v: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            for a in 0..f.vars() {
+                let dense = f.ai_dense(a, 1.0);
+                let form: f64 = (0..n)
+                    .map(|r| v[r] * (0..n).map(|c| dense[r * n + c] * v[c]).sum::<f64>())
+                    .sum();
+                assert!((f.ai_form(a, &v) - form).abs() <= 1e-12 * (1.0 + form.abs()));
+            }
+        }
+        println!("{model:?}: spans {:?}", f.spans);
+    }
 }

@@ -68,8 +68,8 @@ macro_rules! fixed_size {
 /// its Cholesky factor `L` (`a = L Lᵀ`); the strict upper triangle is scratch afterwards.
 /// `false` (and `a` spoilt) when `a` is not positive definite to working precision.
 ///
-/// Above n = 17 row-oriented (each entry of `L` the dot product of two row prefixes, Algorithm
-/// 4.2.1 of Golub and Van Loan); up to n = 17 right-looking on fixed-size rows.
+/// Above n = 17 the pipeline's vectorised column-oriented factorisation (`cholesky_dynamic`);
+/// up to n = 17 right-looking on fixed-size rows.
 #[inline(always)]
 pub(crate) fn cholesky(a: &mut [f64], n: usize) -> bool {
     fixed_size!(n, cholesky_fixed(a), cholesky_dynamic(a, n))
@@ -105,21 +105,24 @@ fn cholesky_fixed<const N: usize>(a: &mut [f64]) -> bool {
     true
 }
 
+/// Above the fixed sizes: the stiffness pipeline's column-oriented (Crout) factorisation,
+/// vectorised ([`sinew_stiffness::cholesky_lower_in_place`]). A symmetric matrix is its own
+/// transpose, so the row-major buffer is read as column-major once its lower triangle is
+/// mirrored into the upper one; the factor, written into the column-major lower triangle
+/// (the row-major upper one), is then mirrored back into the row-major lower triangle.
 fn cholesky_dynamic(a: &mut [f64], n: usize) -> bool {
     let a = &mut a[..n * n];
-    for j in 0..n {
-        let (head, tail) = a.split_at_mut((j + 1) * n);
-        let row_j = &mut head[j * n..j * n + n];
-        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
+    for i in 0..n {
+        for j in 0..i {
+            a[j * n + i] = a[i * n + j];
         }
-        let d = d.sqrt();
-        row_j[j] = d;
-        let inv = 1.0 / d;
-        let row_j = &row_j[..j];
-        for row_i in tail.chunks_exact_mut(n) {
-            row_i[j] = (row_i[j] - dot(&row_i[..j], row_j)) * inv;
+    }
+    if !sinew_stiffness::cholesky_lower_in_place(a, n) {
+        return false;
+    }
+    for i in 0..n {
+        for j in 0..i {
+            a[i * n + j] = a[j * n + i];
         }
     }
     true
@@ -337,6 +340,28 @@ mod tests {
                     assert!((l[r * n + c] - fl[(r, c)]).abs() <= 1e-12 * (1.0 + fl[(r, c)].abs()));
                 }
             }
+            // Only the lower triangle is read.
+            let mut spoilt = a.clone();
+            for r in 0..n {
+                for c in r + 1..n {
+                    spoilt[r * n + c] = f64::NAN;
+                }
+            }
+            assert!(cholesky(&mut spoilt, n), "n = {n}: the upper triangle was read");
+            for r in 0..n {
+                assert_eq!(spoilt[r * n..r * n + r + 1], l[r * n..r * n + r + 1], "n = {n}");
+            }
+            // A forward substitution from a later row, for a right-hand side zero before it,
+            // is the whole one.
+            let start = n / 2;
+            let rhs: Vec<f64> =
+                (0..n).map(|i| if i < start { 0.0 } else { (i as f64).cos() }).collect();
+            let (mut whole, mut from) = (rhs.clone(), rhs.clone());
+            forward_solve_from(&l, n, &mut whole, 0);
+            forward_solve_from(&l, n, &mut from, start);
+            for i in start..n {
+                assert!((whole[i] - from[i]).abs() <= 1e-14 * (1.0 + whole[i].abs()));
+            }
             let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
             let mut b: Vec<f64> =
                 (0..n).map(|r| (0..n).map(|c| a[r * n + c] * x_true[c]).sum()).collect();
@@ -405,6 +430,13 @@ mod tests {
         assert!(!cholesky(&mut a, 2));
         let mut a = vec![1.0, 0.0, 0.0, 0.0];
         assert!(!cholesky(&mut a, 2), "singular is not positive definite");
+        // Above the fixed sizes: one negative direction in a 30 × 30 identity, at its last row.
+        let n = 30;
+        let mut a: Vec<f64> =
+            (0..n * n).map(|e| if e % (n + 1) == 0 { 1.0 } else { 0.0 }).collect();
+        a[(n - 1) * n + n - 2] = 1.5;
+        a[(n - 2) * n + n - 1] = 1.5;
+        assert!(!cholesky(&mut a, n));
     }
 
     #[test]

@@ -30,7 +30,8 @@ pub(crate) struct Frame {
     pub(crate) width: Vec<f64>,
     /// `A(x = 0)`, n × n row-major, N m/rad.
     pub(crate) a0: Vec<f64>,
-    /// `∂A/∂x_a = w_a A_i`, one per free coordinate.
+    /// `∂A/∂x_a = w_a A_i`, one per free coordinate, stored as its square over `spans[a]`
+    /// (row-major, `|span|²` entries; zero outside it).
     pub(crate) ai: Vec<Vec<f64>>,
     /// The rows and columns where each `∂A/∂x_a` can be non-zero ([`Pencil::spans`]): a
     /// decoupled joint's 2 × 2 block, a routed cable's DOFs from the base to its anchor.
@@ -90,31 +91,39 @@ impl Frame {
         }
         // The symmetric parts, row-major, from the pencil's columns (`a[(r, c)]` is entry `r`
         // of column `c`) over the rows and columns `span` where the matrix can be non-zero
-        // (a decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`).
-        let symmetric = |a: &faer::Mat<f64>, span: Range<usize>, scale: f64, out: &mut [f64]| {
+        // (a decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`), into `out`, a square
+        // of side `side` whose first row and column are `origin`'s.
+        let symmetric = |a: &faer::Mat<f64>,
+                         span: Range<usize>,
+                         scale: f64,
+                         out: &mut [f64],
+                         side: usize,
+                         origin: usize| {
             for c in span.clone() {
                 for (r, v) in a.col_as_slice(c)[span.clone()].iter().enumerate() {
-                    let r = r + span.start;
-                    out[r * n + c] += 0.5 * scale * v;
-                    out[c * n + r] += 0.5 * scale * v;
+                    let (r, c) = (r + span.start - origin, c - origin);
+                    out[r * side + c] += 0.5 * scale * v;
+                    out[c * side + r] += 0.5 * scale * v;
                 }
             }
         };
         let span = |i: usize| pencil.spans.get(i).cloned().unwrap_or(0..n);
         let mut a0 = vec![0.0; n * n];
-        symmetric(&pencil.a0, 0..n, 1.0, &mut a0);
+        symmetric(&pencil.a0, 0..n, 1.0, &mut a0, n, 0);
         for (i, (l, a)) in base.iter().zip(&pencil.ai).enumerate() {
             if *l != 0.0 {
-                symmetric(a, span(i), *l, &mut a0);
+                symmetric(a, span(i), *l, &mut a0, n, 0);
             }
         }
         let spans: Vec<Range<usize>> = free.iter().map(|&i| span(i)).collect();
         let ai: Vec<Vec<f64>> = free
             .iter()
             .zip(&width)
-            .map(|(&i, w)| {
-                let mut out = vec![0.0; n * n];
-                symmetric(&pencil.ai[i], span(i), *w, &mut out);
+            .zip(&spans)
+            .map(|((&i, w), span)| {
+                let side = span.len();
+                let mut out = vec![0.0; side * side];
+                symmetric(&pencil.ai[i], span.clone(), *w, &mut out, side, span.start);
                 out
             })
             .collect();
@@ -171,16 +180,41 @@ impl Frame {
 
     /// `A(x)` into `out` (n × n).
     pub(crate) fn a_at(&self, x: &[f64], out: &mut [f64]) {
-        let n = self.n;
         out.copy_from_slice(&self.a0);
-        for ((v, a), span) in x.iter().zip(&self.ai).zip(&self.spans) {
-            for r in span.clone() {
-                let (o, e) = (&mut out[r * n..r * n + n], &a[r * n..r * n + n]);
-                for (o, e) in o[span.clone()].iter_mut().zip(&e[span.clone()]) {
-                    *o += v * e;
-                }
+        for (a, v) in x.iter().enumerate() {
+            self.add_ai(a, *v, out, self.n);
+        }
+    }
+
+    /// `out += scale · ∂A/∂x_a` on the leading n × n of the row-major `out` of side `side`.
+    pub(crate) fn add_ai(&self, a: usize, scale: f64, out: &mut [f64], side: usize) {
+        let span = self.spans[a].clone();
+        let w = span.len();
+        for (r, row) in span.clone().zip(self.ai[a].chunks_exact(w.max(1))) {
+            let out = &mut out[r * side + span.start..r * side + span.end];
+            for (o, e) in out.iter_mut().zip(row) {
+                *o += scale * e;
             }
         }
+    }
+
+    /// `scale · ∂A/∂x_a`, n × n row-major.
+    pub(crate) fn ai_dense(&self, a: usize, scale: f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.n * self.n];
+        self.add_ai(a, scale, &mut out, self.n);
+        out
+    }
+
+    /// `vᵀ (∂A/∂x_a) v`.
+    pub(crate) fn ai_form(&self, a: usize, v: &[f64]) -> f64 {
+        let span = self.spans[a].clone();
+        let w = span.len();
+        let v = &v[span.clone()];
+        self.ai[a]
+            .chunks_exact(w.max(1))
+            .zip(v)
+            .map(|(row, vr)| vr * row.iter().zip(v).map(|(e, vc)| e * vc).sum::<f64>())
+            .sum()
     }
 
     /// `R`: an orthonormal basis of `null(J_r)` (n × (n − 3), row-major), by Gram–Schmidt

@@ -101,7 +101,7 @@ impl<'a> Interior<'a> {
 
     /// `K_x` at `x` (`None` where `A ⊁ 0` or `J_x` has rank < 6).
     fn k_x_at(&self, x: &[f64]) -> Option<nalgebra::Matrix6<f64>> {
-        EndObjective::new(self.frame, Kind::Volume, 1.0).end_at(x).map(|e| e.k_x)
+        EndObjective::end_only(self.frame).end_at(x).map(|e| e.k_x)
     }
 
     fn settings(&self, target: Option<f64>, relative_gap: f64, scale: f64) -> Settings {
@@ -188,7 +188,7 @@ impl<'a> Interior<'a> {
     }
 
     /// The floors of the requirements, in order (`k_min`, then `K_des`): `(K, τ)`.
-    fn floors(&self) -> Vec<(Floor, f64, &'static str)> {
+    pub(crate) fn floors(&self) -> Vec<(Floor, f64, &'static str)> {
         let mut out = Vec::new();
         if let Some(k) = self.requirements.k_min {
             out.push((Floor { k: Matrix3::identity() }, k, "least stiffness λ_min(K_fd), N/m,"));
@@ -221,7 +221,7 @@ impl<'a> Interior<'a> {
     }
 
     /// The least `τ` with `K_fd ⪰ τ K` at `x` (the generalised eigenvalue).
-    fn floor_value(&self, x: &[f64], floor: &Floor) -> Option<f64> {
+    pub(crate) fn floor_value(&self, x: &[f64], floor: &Floor) -> Option<f64> {
         let k_fd = self.k_x_at(x)?.fixed_view::<3, 3>(0, 0).into_owned();
         let l = floor.k.cholesky()?.l();
         let l_inv = l.try_inverse()?;
@@ -390,76 +390,6 @@ impl<'a> Interior<'a> {
         let mut x = run.x;
         x.truncate(k);
         Ok(Answer { x, upper: run.upper * scale, iterations: run.iterations })
-    }
-
-    /// Whether `x` is strictly inside the rows, the margin and the floors.
-    fn strictly_inside(&self, x: &[f64]) -> bool {
-        let f = self.frame;
-        let k = f.vars();
-        let rows = (0..f.rhs.len()).all(|r| {
-            f.rows[r * k..r * k + k].iter().zip(x).map(|(a, b)| a * b).sum::<f64>() < f.rhs[r]
-        });
-        let n = f.n;
-        let mut a = vec![0.0; n * n];
-        f.a_at(x, &mut a);
-        for i in 0..n {
-            a[i * n + i] -= self.requirements.margin;
-        }
-        rows && crate::dense::cholesky(&mut a, n)
-            && self
-                .floors()
-                .iter()
-                .all(|(floor, tau, _)| self.floor_value(x, floor).is_some_and(|v| v > *tau))
-    }
-
-    /// `x` when strictly inside; else one least-norm step onto the linearised violated rows
-    /// and margin (each moved a little inside), kept when it lands strictly inside.
-    pub(crate) fn restored(&self, x: Vec<f64>) -> Option<Vec<f64>> {
-        if self.strictly_inside(&x) {
-            return Some(x);
-        }
-        let f = self.frame;
-        let (k, n) = (f.vars(), f.n);
-        // Active constraints as J d = b.
-        let (mut jac, mut b): (Vec<Vec<f64>>, Vec<f64>) = (Vec::new(), Vec::new());
-        const INSIDE: f64 = 1e-4;
-        for r in 0..f.rhs.len() {
-            let g = &f.rows[r * k..r * k + k];
-            let slack = f.rhs[r] - g.iter().zip(&x).map(|(a, c)| a * c).sum::<f64>();
-            if slack < INSIDE {
-                jac.push(g.to_vec());
-                b.push(slack - INSIDE);
-            }
-        }
-        let m = self.requirements.margin;
-        let mut a = vec![0.0; n * n];
-        f.a_at(&x, &mut a);
-        let eigen = DMatrix::from_row_slice(n, n, &a).symmetric_eigen();
-        let i = eigen.eigenvalues.imin();
-        let needed = m + INSIDE * f.a_scale.max(m);
-        if eigen.eigenvalues[i] < needed {
-            let v = eigen.eigenvectors.column(i);
-            let h: Vec<f64> = f
-                .ai
-                .iter()
-                .map(|ai| {
-                    (0..n).map(|r| v[r] * (0..n).map(|c| ai[r * n + c] * v[c]).sum::<f64>()).sum()
-                })
-                .collect();
-            jac.push(h.iter().map(|v| -v).collect());
-            b.push(eigen.eigenvalues[i] - needed);
-        }
-        let p = jac.len();
-        let gram =
-            DMatrix::from_fn(p, p, |r, c| jac[r].iter().zip(&jac[c]).map(|(u, w)| u * w).sum());
-        let w = gram.cholesky()?.solve(&nalgebra::DVector::from_vec(b));
-        let mut restored = x;
-        for (row, wr) in jac.iter().zip(w.iter()) {
-            for (xa, g) in restored.iter_mut().zip(row) {
-                *xa += wr * g;
-            }
-        }
-        self.strictly_inside(&restored).then_some(restored)
     }
 
     /// `uᵀ J_p A⁻¹ J_pᵀ u` at `x` (`None` where `A ⊁ 0`).

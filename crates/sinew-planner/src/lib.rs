@@ -57,6 +57,7 @@ mod phases;
 mod plan;
 mod problem;
 mod program;
+mod restore;
 mod rows;
 mod sdp;
 mod smooth;

@@ -64,20 +64,34 @@ pub(crate) struct EndAt {
 
 impl<'a> EndObjective<'a> {
     pub(crate) fn new(frame: &'a Frame, kind: Kind, scale: f64) -> EndObjective<'a> {
+        let columns = match kind {
+            Kind::Along(_) => 1,
+            Kind::Volume => 3,
+        };
+        Self::with_columns(frame, kind, scale, columns)
+    }
+
+    /// Buffers for [`Self::end_at`] only (`K_x` at a point, no derivatives).
+    pub(crate) fn end_only(frame: &'a Frame) -> EndObjective<'a> {
+        Self::with_columns(frame, Kind::Volume, 1.0, 0)
+    }
+
+    /// The buffers of the derivatives sized for `c` vectors `z_j`.
+    fn with_columns(frame: &'a Frame, kind: Kind, scale: f64, c: usize) -> EndObjective<'a> {
         let (n, k) = (frame.n, frame.vars());
-        let supports = frame.spans.clone();
+        let k = if c == 0 { 0 } else { k };
         EndObjective {
             frame,
             kind,
             scale,
             a: vec![0.0; n * n],
             yt: vec![0.0; 6 * n],
-            supports,
-            zs: vec![0.0; 3 * n],
-            az: vec![0.0; k * 3 * n],
-            la: vec![0.0; k * 3 * n],
-            ta: vec![0.0; k * 3 * 6],
-            g: vec![0.0; k * 9],
+            supports: frame.spans.clone(),
+            zs: vec![0.0; c * n],
+            az: vec![0.0; k * c * n],
+            la: vec![0.0; k * c * n],
+            ta: vec![0.0; k * c * 6],
+            g: vec![0.0; k * c * c],
         }
     }
 
@@ -130,8 +144,9 @@ impl<'a> EndObjective<'a> {
             for (j, z) in zs.chunks_exact(n).enumerate() {
                 let out = &mut self.az[(a * c + j) * n..(a * c + j + 1) * n];
                 out.fill(0.0);
-                for r in rows.clone() {
-                    out[r] = dot(&ai[r * n..r * n + n][rows.clone()], &z[rows.clone()]);
+                let w = rows.len();
+                for (r, row) in rows.clone().zip(ai.chunks_exact(w.max(1))) {
+                    out[r] = dot(row, &z[rows.clone()]);
                 }
             }
         }

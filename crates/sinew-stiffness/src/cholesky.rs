@@ -17,7 +17,7 @@ pub(crate) const SMALL: usize = 100;
 /// `L Lᵀ = A` in place on the lower triangle of the column-major `n × n` matrix `a` (the upper
 /// triangle is not written; its values are read but do not reach the result): `false` when a
 /// pivot is not positive (or not a number), i.e. `A` is not positive definite. No allocation.
-pub(crate) fn cholesky_lower_in_place(a: &mut [f64], n: usize) -> bool {
+pub fn cholesky_lower_in_place(a: &mut [f64], n: usize) -> bool {
     if a.len() != n * n {
         return false;
     }

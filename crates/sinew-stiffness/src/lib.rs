@@ -51,6 +51,7 @@ mod stick_limit;
 mod structured;
 
 pub use arm::ArmStiffness;
+pub use cholesky::cholesky_lower_in_place;
 pub use data::{ArmStiffnessData, EndOutcome, EndSolver};
 pub use directional::{DirectionalResponse, Increment, directional_response, sliding_response};
 pub use ellipsoid::StiffnessEllipsoid;
