@@ -245,3 +245,31 @@ fn the_frames_compact_coefficients_are_the_pencils() {
         println!("{model:?}: spans {:?}", f.spans);
     }
 }
+
+/// A pencil refilled in its own buffers (the planner's workspace keeps one between plans) is
+/// the pencil filled afresh: the routed arm's `A_i` span the DOFs from the base, the decoupled
+/// arm's one joint each, so zeroing the new spans instead of the old leaves the routed
+/// entries behind and fails this.
+#[test]
+fn a_refilled_pencil_is_a_fresh_one() {
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let fill = |model: PatternModel, pencil: &mut crate::pencil::Pencil| {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut sd = ArmStiffnessData::new(&arm);
+        arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
+        let set = arm.equilibrium_set(&mut sd).unwrap().clone();
+        arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
+        pencil.fill(&arm, &mut sd, &set).unwrap();
+    };
+    let mut reused = crate::pencil::Pencil::empty();
+    fill(PatternModel::Routed, &mut reused);
+    fill(PatternModel::Decoupled, &mut reused);
+    let mut fresh = crate::pencil::Pencil::empty();
+    fill(PatternModel::Decoupled, &mut fresh);
+    assert_eq!(reused.ai.len(), fresh.ai.len());
+    for (i, (a, b)) in reused.ai.iter().zip(&fresh.ai).enumerate() {
+        assert!(a == b, "A_{i} differs after a refill");
+    }
+    assert!(reused.a0 == fresh.a0 && reused.spans == fresh.spans);
+}

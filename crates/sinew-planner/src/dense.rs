@@ -166,6 +166,7 @@ fn cholesky_solve_fixed<const N: usize>(l: &[f64], b: &mut [f64]) {
     }
 }
 
+#[inline(always)]
 fn cholesky_solve_dynamic(l: &[f64], n: usize, b: &mut [f64]) {
     let b = &mut b[..n];
     for i in 0..n {

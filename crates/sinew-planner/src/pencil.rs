@@ -39,6 +39,9 @@ pub(crate) struct Pencil {
     /// that `N`'s column `i` weighs (`A_i = Σ_c N_ci H_c`, and `H_c` lives on cable `c`'s
     /// DOFs; so does its stick stiffness). A decoupled `A_i` is one joint's 2 × 2 block.
     pub(crate) spans: Vec<std::ops::Range<usize>>,
+    /// Whether the `A_i` may be non-zero outside their spans: after the stick regime's fill
+    /// (which writes them whole) or one that did not complete.
+    whole: bool,
 }
 
 /// The end quantities at a point where `A ≻ 0`.
@@ -82,6 +85,7 @@ impl Pencil {
         }
         self.copy_j_x(sd.j_x());
         self.fill_spans(arm, set);
+        self.whole = false;
         Ok(())
     }
 
@@ -126,7 +130,10 @@ impl Pencil {
         Ok(())
     }
 
-    /// `A_0`, `K_W` and `k` coefficients of `dof × dof`, zero.
+    /// `A_0`, `K_W` and `k` coefficients of `dof × dof`, zero. An `A_i` of the last fill of the
+    /// same size is zeroed over its span only, where that fill wrote it (the cables' Hessians
+    /// live on their DOFs): a 200-DOF chain's 100 coefficients would otherwise be 32 MB of
+    /// stores per plan.
     /// [`Pencil::spans`] of `set`'s null basis over `arm`'s cables.
     fn fill_spans(&mut self, arm: &ArmStiffness, set: &EquilibriumSet) {
         let (cables, null) = (arm.routing().cables(), set.null_basis());
@@ -154,8 +161,19 @@ impl Pencil {
         reset(&mut self.a0);
         reset(&mut self.k_w);
         self.ai.truncate(k);
-        self.ai.iter_mut().for_each(reset);
+        for (i, a) in self.ai.iter_mut().enumerate() {
+            match self.spans.get(i) {
+                Some(span) if !self.whole && a.nrows() == dof && a.ncols() == dof => {
+                    for c in span.clone() {
+                        a.col_as_slice_mut(c)[span.clone()].fill(0.0);
+                    }
+                }
+                _ => reset(a),
+            }
+        }
         self.ai.resize_with(k, || Mat::zeros(dof, dof));
+        // Until a fill completes, where it writes is not known.
+        self.whole = true;
     }
 
     fn copy_j_x(&mut self, j_x: MatRef<'_, f64>) {
@@ -175,6 +193,7 @@ impl Pencil {
             weights: Vec::new(),
             k_w: Mat::zeros(0, 0),
             spans: Vec::new(),
+            whole: true,
         }
     }
 

@@ -51,8 +51,9 @@ pub(crate) struct EndObjective<'a> {
     /// `A_a z_j` and `L⁻¹ A_a z_j` (k × c × n).
     az: Vec<f64>,
     la: Vec<f64>,
-    /// `Yᵀ A_a z_j` (k × c × 6).
+    /// `Yᵀ A_a z_j` and `K_x Yᵀ A_a z_j` (k × c × 6).
     ta: Vec<f64>,
+    kta: Vec<f64>,
     /// `G_a = zsᵀ A_a zs` (k × c × c).
     g: Vec<f64>,
 }
@@ -91,12 +92,14 @@ impl<'a> EndObjective<'a> {
             az: vec![0.0; k * c * n],
             la: vec![0.0; k * c * n],
             ta: vec![0.0; k * c * 6],
+            kta: vec![0.0; k * c * 6],
             g: vec![0.0; k * c * c],
         }
     }
 
     /// Factor `A(x)` and form `Y`, `C_x`, `K_x`; `None` where `A` is not positive definite or
     /// `J_x` has rank < 6.
+    #[inline(always)]
     pub(crate) fn end_at(&mut self, x: &[f64]) -> Option<EndAt> {
         let n = self.frame.n;
         self.frame.a_at(x, &mut self.a);
@@ -115,6 +118,7 @@ impl<'a> EndObjective<'a> {
     }
 
     /// `z_j = Y K_x m_j` for the 6-vectors `columns` into `self.zs`.
+    #[inline(always)]
     fn v_times(&mut self, k_x: &Matrix6<f64>, columns: &[Vector6<f64>]) {
         let n = self.frame.n;
         for (m, z) in columns.iter().zip(self.zs.chunks_exact_mut(n)) {
@@ -128,6 +132,7 @@ impl<'a> EndObjective<'a> {
 
     /// The gradient and Hessian (unscaled) of the form with the `c` vectors `z_j` in
     /// `self.zs`, the 3 × 3 `G_a` terms when `volume`.
+    #[inline(always)]
     fn forms(
         &mut self,
         k_x: &Matrix6<f64>,
@@ -173,9 +178,11 @@ impl<'a> EndObjective<'a> {
                 let (az, la) = (&self.az[at..at + n], &mut self.la[at..at + n]);
                 la.copy_from_slice(az);
                 forward_solve_from(&self.a, n, la, rows.start.min(n));
-                for (i, y) in self.yt.chunks_exact(n).enumerate() {
-                    self.ta[(a * c + j) * 6 + i] = dot(&y[rows.clone()], &az[rows.clone()]);
-                }
+                let t = Vector6::from_fn(|i, _| {
+                    dot(&self.yt[i * n..i * n + n][rows.clone()], &az[rows.clone()])
+                });
+                self.ta[(a * c + j) * 6..][..6].copy_from_slice(t.as_slice());
+                self.kta[(a * c + j) * 6..][..6].copy_from_slice((k_x * t).as_slice());
             }
         }
         for a in 0..k {
@@ -185,9 +192,8 @@ impl<'a> EndObjective<'a> {
                 for j in 0..c {
                     let (ra, rb) = ((a * c + j) * n, (b * c + j) * n);
                     cross += dot(&self.la[ra + from..ra + n], &self.la[rb + from..rb + n]);
-                    let ta = Vector6::from_column_slice(&self.ta[(a * c + j) * 6..][..6]);
-                    let tb = Vector6::from_column_slice(&self.ta[(b * c + j) * 6..][..6]);
-                    cross -= ta.dot(&(k_x * tb));
+                    cross -=
+                        dot(&self.ta[(a * c + j) * 6..][..6], &self.kta[(b * c + j) * 6..][..6]);
                 }
                 let gg = if volume {
                     dot(&self.g[a * c * c..(a + 1) * c * c], &self.g[b * c * c..(b + 1) * c * c])
@@ -202,7 +208,39 @@ impl<'a> EndObjective<'a> {
 }
 
 impl Smooth for EndObjective<'_> {
+    /// Compiled once per instruction set and dispatched by pulp, as the method's own loop is
+    /// (`sdp.rs`): the objective is called through `dyn Smooth`, outside that loop's dispatch,
+    /// and its substitutions and dot products are the larger part of an iteration above 16 DOF.
     fn evaluate(&mut self, x: &[f64], gradient: &mut [f64], hessian: &mut [f64]) -> Option<f64> {
+        pulp::Arch::new().dispatch(Evaluate { objective: self, x, gradient, hessian })
+    }
+}
+
+/// [`EndObjective`]'s evaluation as a pulp operation.
+struct Evaluate<'o, 'a, 'v> {
+    objective: &'o mut EndObjective<'a>,
+    x: &'v [f64],
+    gradient: &'v mut [f64],
+    hessian: &'v mut [f64],
+}
+
+impl pulp::WithSimd for Evaluate<'_, '_, '_> {
+    type Output = Option<f64>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<f64> {
+        self.objective.evaluate_body(self.x, self.gradient, self.hessian)
+    }
+}
+
+impl EndObjective<'_> {
+    #[inline(always)]
+    fn evaluate_body(
+        &mut self,
+        x: &[f64],
+        gradient: &mut [f64],
+        hessian: &mut [f64],
+    ) -> Option<f64> {
         let end = self.end_at(x)?;
         let k_x = end.k_x;
         let value = match self.kind {
