@@ -67,8 +67,8 @@ pub use geometry::{
     compute_cable_geometry_from_kinematics,
 };
 pub use routing::{
-    Cable, CableView, Hole, HoleView, MIN_SEGMENT_LENGTH, ROUTED_ROUTING_FILE, ROUTING_FILE,
-    Routing, RoutingModel, RoutingView, Segment, load, routing_file,
+    Cable, CableView, Hole, HoleView, MAX_HOLE_OFFSET, MIN_SEGMENT_LENGTH, ROUTED_ROUTING_FILE,
+    ROUTING_FILE, Routing, RoutingModel, RoutingView, Segment, load, routing_file,
 };
 pub use spec::{
     CableFriction, ExplicitCable, HoleSpec, Material, Pattern, PatternModel, PerJoint, RoutingSpec,

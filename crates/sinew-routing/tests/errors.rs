@@ -310,13 +310,27 @@ fn bad_numbers_in_cables() {
     let text = explicit(GOOD_CABLE).replace("free_length = 1.0", "free_length = [1.0, 1.0]");
     let err = error(&text, &["free_length", "2 entries"]);
     assert!(matches!(err, RoutingError::PatternSize { .. }), "{err:?}");
-    // Far-away holes: a segment of infinite length.
-    let text = explicit(&GOOD_CABLE.replace(
+    // Far-away holes: finite, but the cable Hessians' products of lever arms overflow (a
+    // proptest case of `mutated_valid_files_never_panic` found it through the pattern's
+    // radius). Refused at the point, or the radius, beyond `MAX_HOLE_OFFSET`.
+    for far in ["1e308", "1001.0", "-2e3"] {
+        let text = explicit(&GOOD_CABLE.replace(
+            "point = [0.02, 0.0, 0.0] },\n  { link = \"link1\"",
+            &format!("point = [{far}, 0.0, 0.0] }},\n  {{ link = \"link1\""),
+        ));
+        let err = error(&text, &["good", "cable[0].holes[0].point", "1 km"]);
+        assert!(matches!(err, RoutingError::InvalidValue { .. }), "{err:?}");
+    }
+    let near = explicit(&GOOD_CABLE.replace(
         "point = [0.02, 0.0, 0.0] },\n  { link = \"link1\"",
-        "point = [1e308, 0.0, 0.0] },\n  { link = \"link1\"",
+        "point = [999.0, 0.0, 0.0] },\n  { link = \"link1\"",
     ));
-    let err = error(&text, &["good", "segment 0"]);
-    assert!(matches!(err, RoutingError::ZeroLengthSegment { .. }), "{err:?}");
+    assert!(load(&near).is_ok(), "a hole within the bound loads");
+    for far in ["1e308", "1001.0"] {
+        let text = pattern(PROXIMAL, DISTAL).replace("radius = 0.022", &format!("radius = {far}"));
+        let err = error(&text, &["pattern.radius", "1 km"]);
+        assert!(matches!(err, RoutingError::InvalidValue { .. }), "{err:?}");
+    }
 }
 
 #[test]

@@ -4,10 +4,10 @@
 use nalgebra::Vector3;
 use sinew_robot::Robot;
 
-use super::Hole;
 use super::friction::{
     DEFAULT_ENTRY_DIRECTION, check_coefficient, check_entry_direction, check_pattern_names,
 };
+use super::{Hole, MAX_HOLE_OFFSET};
 use crate::error::{JointProblem, Result, RoutingError};
 use crate::spec::{PatternModel, PerJoint, RoutingSpec};
 
@@ -133,7 +133,8 @@ pub(super) fn expand_pattern(
                 });
             }
         };
-        check_per_joint(file, &field, &value, n, |v| v > 0.0, "finite and > 0 m")?;
+        let ok = |v: f64| v > 0.0 && v <= MAX_HOLE_OFFSET;
+        check_per_joint(file, &field, &value, n, ok, "finite, > 0 m and at most 1 km")?;
         Ok(value)
     };
     let proximal_radius = radius("proximal_radius", &pattern.proximal_radius)?;
@@ -254,13 +255,13 @@ pub(super) fn check_cable(
                 link: link.clone(),
             });
         }
-        if let Some(&v) = point.iter().find(|v| !v.is_finite()) {
+        if let Some(&v) = point.iter().find(|v| !(v.is_finite() && v.abs() <= MAX_HOLE_OFFSET)) {
             return Err(RoutingError::InvalidValue {
                 file: file.to_owned(),
                 cable: name.clone(),
                 field: field.replace(".link", ".point"),
                 value: v,
-                expected: "finite coordinates in m",
+                expected: "finite coordinates in m, within 1 km of the link's origin",
             });
         }
         let point = Vector3::from(*point);

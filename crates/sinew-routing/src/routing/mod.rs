@@ -43,6 +43,11 @@ pub fn routing_file(model: PatternModel) -> &'static str {
 /// configuration when evaluating) have no well-defined direction and are errors.
 pub const MIN_SEGMENT_LENGTH: f64 = 1e-6;
 
+/// The farthest a hole may lie from its link's origin, m (each coordinate): a disc of a
+/// manipulator is centimetres across. A hole at 1e308 m loads as finite but overflows the
+/// cable Hessians' products of lever arms, so it is an input error, not a NaN later.
+pub const MAX_HOLE_OFFSET: f64 = 1e3;
+
 /// How the routing was given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
