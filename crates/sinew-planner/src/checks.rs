@@ -178,6 +178,7 @@ fn the_method_finds_a_hand_solved_optimum_and_certifies_it() {
         n: 2,
         constant: vec![1.0, 0.0, 0.0, 1.0],
         coefficients: vec![Some(vec![1.0, 0.0, 0.0, -1.0]), Some(vec![-1.0, 0.0, 0.0, -1.0])],
+        factors: None,
     };
     let sdp = Sdp {
         c0: 0.0,
@@ -272,4 +273,60 @@ fn a_refilled_pencil_is_a_fresh_one() {
         assert!(a == b, "A_{i} differs after a refill");
     }
     assert!(reused.a0 == fresh.a0 && reused.spans == fresh.spans);
+}
+
+/// The Schur terms of a stiffness floor's block from its factored coefficients
+/// (`R_aᵀ B_a R_a`: `block_work::add_factored_schur`) are those of its dense ones, for random
+/// `Z ⪰ 0` and the block's own `S⁻¹`, with and without an epigraph coefficient (factored and
+/// unfactored pairs). A wrong entry of `G_d`, `W` or `V` (its diagonal only, another joint's
+/// rows) fails it.
+#[test]
+fn a_floors_factored_schur_terms_are_its_dense_ones() {
+    use crate::block_work::{BlockWork, add_block_schur};
+    use crate::blocks::{Floor, floor_block};
+    // A 12-joint weightless chain under a small tip force: 24 DOFs, a 21 × 21 floor, above
+    // the fixed-size kernels (below them the floor is not factored).
+    let (robot, routing) = cdhrm5::chain(12, PatternModel::Decoupled);
+    let robot = robot.with_gravity(nalgebra::Vector3::zeros());
+    let arm = ArmStiffness::new(&robot, &routing).unwrap();
+    let mut sd = ArmStiffnessData::new(&arm);
+    let q: Vec<f64> = (0..24).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+    arm.set_pose(&mut sd, &q, &Vector6::new(0.0, 0.1, 0.05, 0.0, 0.0, 0.0)).unwrap();
+    let set = arm.equilibrium_set(&mut sd).unwrap().clone();
+    arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 12])).unwrap();
+    let mut pencil = crate::pencil::Pencil::empty();
+    pencil.fill(&arm, &mut sd, &set).unwrap();
+    let f = Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[]);
+    let r = f.rotation_null_basis().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let x = stable_points(&f, 0.0, 1, 5).remove(0);
+    let k = nalgebra::Matrix3::new(2.0, 0.3, 0.1, 0.3, 1.0, 0.2, 0.1, 0.2, 1.5);
+    for tau in [Ok(0.5), Err(2.0)] {
+        let factored = floor_block(&f, Some(&r), Floor { k }, tau, 1).unwrap();
+        assert!(factored.factors.as_ref().unwrap().small[..f.vars()].iter().all(Option::is_some));
+        let dense = Block { factors: None, ..factored.clone() };
+        let n = factored.n;
+        let mut xs = x.clone();
+        xs.push(0.1);
+        let b = DMatrix::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
+        let z_m = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
+        let z: Vec<f64> = (0..n * n).map(|e| z_m[(e / n, e % n)]).collect();
+        let schur = |block: &Block| {
+            let mut w = BlockWork::new(block);
+            let mut s = vec![0.0; n * n];
+            block.at(&xs, &mut s);
+            let s_m = DMatrix::from_fn(n, n, |i, j| s[i * n + j]);
+            let s_inv = s_m.try_inverse().unwrap();
+            w.s_inv = (0..n * n).map(|e| s_inv[(e / n, e % n)]).collect();
+            let kk = f.vars() + 1;
+            let mut out = vec![0.0; kk * kk];
+            add_block_schur(block, &z, &mut w, kk, &mut out);
+            out
+        };
+        let (a, d) = (schur(&factored), schur(&dense));
+        let size = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (e, (u, v)) in a.iter().zip(&d).enumerate() {
+            assert!((u - v).abs() <= 1e-11 * size, "{tau:?}: entry {e}: {u} against {v}");
+        }
+    }
 }

@@ -29,6 +29,21 @@ pub(crate) struct Block {
     pub(crate) constant: Vec<f64>,
     /// One per variable; `None` where the block does not depend on it.
     pub(crate) coefficients: Vec<Option<Vec<f64>>>,
+    /// The same coefficients as congruences of small blocks, where the block has them (a
+    /// stiffness floor of the decoupled model); only the Schur terms read them.
+    pub(crate) factors: Option<Factors>,
+}
+
+/// Coefficients `F_a = R_aᵀ B_a R_a`, `R_a` the rows `span_a` of a basis `R` (q × n,
+/// row-major) and `B_a` symmetric, |span_a| × |span_a|: a floor's `Rᵀ A_a R` with `A_a` one
+/// joint's 2 × 2 block. With them the Schur terms need `R Z Rᵀ` and `R S⁻¹ Rᵀ` once an
+/// iteration, not two n × n products per coefficient (`block_work.rs`).
+#[derive(Debug, Clone)]
+pub(crate) struct Factors {
+    pub(crate) basis: Vec<f64>,
+    pub(crate) q: usize,
+    /// Per coefficient: `(span_a, B_a)`, or `None` where it is not factored (used whole).
+    pub(crate) small: Vec<Option<(std::ops::Range<usize>, Vec<f64>)>>,
 }
 
 impl Block {
