@@ -19,8 +19,11 @@ use crate::DynResult;
 
 /// What pip installs into the virtualenv: the tests' dependencies only (mujoco: the exported
 /// MJCF models are checked by the simulator, `crates/sinew-py/tests/test_mujoco.py`; dask's for
-/// the `sinew.dask` tests: a two-worker LocalCluster).
-const PYTHON_PACKAGES: [&str; 5] = ["numpy", "pytest", "mujoco", "dask[array]", "distributed"];
+/// the `sinew.dask` tests: a two-worker LocalCluster). Dask through its `distributed` extra,
+/// which pins distributed to dask's own version: asked for separately, pip once took dask
+/// 2026.11.0 before its distributed was published and paired it with distributed 2021.4.1,
+/// which does not import.
+const PYTHON_PACKAGES: [&str; 4] = ["numpy", "pytest", "mujoco", "dask[array,distributed]"];
 
 /// Cargo's target folder: `$CARGO_TARGET_DIR` (relative to the workspace) or `target/`.
 fn target_dir(root: &Path) -> std::path::PathBuf {
