@@ -65,12 +65,19 @@ impl BlockWork {
                 _ => Vec::new(),
             })
             .collect();
+        // A factored block (`Block::factors`) uses its factored coefficients' `F_a Z` and
+        // `S⁻¹ F_a` nowhere: the products and `R (Z F_a S⁻¹) Rᵀ` only for the others.
         let q = b.factors.as_ref().map_or(0, |f| f.q);
-        let factored = |len: usize| vec![0.0; len];
-        let products = || {
-            b.coefficients
-                .iter()
-                .map(|f| if f.is_some() { z() } else { Vec::new() })
+        let whole = |a: usize| {
+            b.coefficients[a].is_some()
+                && b.factors.as_ref().is_none_or(|f| f.small.get(a).is_none_or(Option::is_none))
+        };
+        let products = |len: usize, only_factored_blocks: bool| {
+            (0..b.coefficients.len())
+                .map(|a| {
+                    let wanted = whole(a) && (!only_factored_blocks || b.factors.is_some());
+                    if wanted { vec![0.0; len] } else { Vec::new() }
+                })
                 .collect::<Vec<_>>()
         };
         BlockWork {
@@ -87,22 +94,12 @@ impl BlockWork {
             product: z(),
             correction: z(),
             trial: z(),
-            fz: products(),
-            sf: products(),
-            rx: factored(q * n),
-            rzr: factored(q * q),
-            rsr: factored(q * q),
-            rqr: b
-                .coefficients
-                .iter()
-                .enumerate()
-                .map(|(a, f)| match (f, &b.factors) {
-                    (Some(_), Some(fac)) if fac.small.get(a).is_none_or(Option::is_none) => {
-                        vec![0.0; q * q]
-                    }
-                    _ => Vec::new(),
-                })
-                .collect(),
+            fz: products(n * n, false),
+            sf: products(n * n, false),
+            rx: vec![0.0; q * n],
+            rzr: vec![0.0; q * q],
+            rsr: vec![0.0; q * q],
+            rqr: products(q * q, true),
             supports,
             dense,
             sub,

@@ -12,7 +12,6 @@ use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
 
-use crate::Planner;
 use crate::blocks::{base, margin_block};
 use crate::frame::Frame;
 use crate::program::{Block, Duals, End, Sdp, Settings, Smooth, bound_at};
@@ -22,16 +21,25 @@ use crate::smooth::{EndObjective, Kind};
 
 fn frame(model: PatternModel) -> Frame {
     let (robot, routing) = cdhrm5::robot_and_routing(model);
-    let arm = ArmStiffness::new(&robot, &routing).unwrap();
-    let planner = Planner::new(arm.clone());
-    let mut sd = ArmStiffnessData::new(&arm);
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
+    fill(&robot, &routing, &cdhrm5::LOADED_POSE, &f0, &mut crate::pencil::Pencil::empty())
+}
+
+/// `pencil` filled at `q` under `f0` (levels ½, the equilibrium set's), and its frame.
+fn fill(
+    robot: &sinew_robot::Robot,
+    routing: &sinew_routing::Routing,
+    q: &[f64],
+    f0: &Vector6<f64>,
+    pencil: &mut crate::pencil::Pencil,
+) -> Frame {
+    let arm = ArmStiffness::new(robot, routing).unwrap();
+    let mut sd = ArmStiffnessData::new(&arm);
+    arm.set_pose(&mut sd, q, f0).unwrap();
     let set = arm.equilibrium_set(&mut sd).unwrap().clone();
-    arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
-    let mut pencil = crate::pencil::Pencil::empty();
-    pencil.fill(planner.arm(), &mut sd, &set).unwrap();
-    Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[])
+    arm.set_tensions(&mut sd, TensionChoice::Levels(&vec![0.5; set.dimension()])).unwrap();
+    pencil.fill(&arm, &mut sd, &set).unwrap();
+    Frame::new(pencil, &set, &linear_rows(&set, None, &[]).merged(), &[])
 }
 
 /// Random points strictly inside the rows with `A(x) ≻ margin I`.
@@ -212,15 +220,9 @@ fn the_frames_compact_coefficients_are_the_pencils() {
     let mut rng = ChaCha8Rng::seed_from_u64(23);
     for model in cdhrm5::MODELS {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
-        let arm = ArmStiffness::new(&robot, &routing).unwrap();
-        let mut sd = ArmStiffnessData::new(&arm);
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-        arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
-        let set = arm.equilibrium_set(&mut sd).unwrap().clone();
-        arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
         let mut pencil = crate::pencil::Pencil::empty();
-        pencil.fill(&arm, &mut sd, &set).unwrap();
-        let f = Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[]);
+        let f = fill(&robot, &routing, &cdhrm5::LOADED_POSE, &f0, &mut pencil);
         let n = f.n;
         for _ in 0..5 {
             let x: Vec<f64> = (0..f.vars()).map(|_| rng.random_range(-1.0..1.0)).collect();
@@ -254,20 +256,15 @@ fn the_frames_compact_coefficients_are_the_pencils() {
 #[test]
 fn a_refilled_pencil_is_a_fresh_one() {
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
-    let fill = |model: PatternModel, pencil: &mut crate::pencil::Pencil| {
+    let fill_model = |model: PatternModel, pencil: &mut crate::pencil::Pencil| {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
-        let arm = ArmStiffness::new(&robot, &routing).unwrap();
-        let mut sd = ArmStiffnessData::new(&arm);
-        arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
-        let set = arm.equilibrium_set(&mut sd).unwrap().clone();
-        arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 5])).unwrap();
-        pencil.fill(&arm, &mut sd, &set).unwrap();
+        fill(&robot, &routing, &cdhrm5::LOADED_POSE, &f0, pencil);
     };
     let mut reused = crate::pencil::Pencil::empty();
-    fill(PatternModel::Routed, &mut reused);
-    fill(PatternModel::Decoupled, &mut reused);
+    fill_model(PatternModel::Routed, &mut reused);
+    fill_model(PatternModel::Decoupled, &mut reused);
     let mut fresh = crate::pencil::Pencil::empty();
-    fill(PatternModel::Decoupled, &mut fresh);
+    fill_model(PatternModel::Decoupled, &mut fresh);
     assert_eq!(reused.ai.len(), fresh.ai.len());
     for (i, (a, b)) in reused.ai.iter().zip(&fresh.ai).enumerate() {
         assert!(a == b, "A_{i} differs after a refill");
@@ -288,15 +285,9 @@ fn a_floors_factored_schur_terms_are_its_dense_ones() {
     // the fixed-size kernels (below them the floor is not factored).
     let (robot, routing) = cdhrm5::chain(12, PatternModel::Decoupled);
     let robot = robot.with_gravity(nalgebra::Vector3::zeros());
-    let arm = ArmStiffness::new(&robot, &routing).unwrap();
-    let mut sd = ArmStiffnessData::new(&arm);
     let q: Vec<f64> = (0..24).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
-    arm.set_pose(&mut sd, &q, &Vector6::new(0.0, 0.1, 0.05, 0.0, 0.0, 0.0)).unwrap();
-    let set = arm.equilibrium_set(&mut sd).unwrap().clone();
-    arm.set_tensions(&mut sd, TensionChoice::Levels(&[0.5; 12])).unwrap();
-    let mut pencil = crate::pencil::Pencil::empty();
-    pencil.fill(&arm, &mut sd, &set).unwrap();
-    let f = Frame::new(&pencil, &set, &linear_rows(&set, None, &[]).merged(), &[]);
+    let f0 = Vector6::new(0.0, 0.1, 0.05, 0.0, 0.0, 0.0);
+    let f = fill(&robot, &routing, &q, &f0, &mut crate::pencil::Pencil::empty());
     let r = f.rotation_null_basis().unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let x = stable_points(&f, 0.0, 1, 5).remove(0);
