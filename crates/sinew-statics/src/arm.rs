@@ -47,8 +47,10 @@ pub struct ArmStaticsData {
     /// tensions).
     pub distribution: Option<Distribution>,
     /// The equilibrium set at the pose, once a policy or [`ArmStatics::equilibrium_set`] asked
-    /// for it (cleared by every pose stage).
+    /// for it (`set_current`; every pose stage clears it, and the next set is rebuilt in this
+    /// one's buffers).
     set: Option<EquilibriumSet>,
+    set_current: bool,
     /// How the tensions of the last tension stage were chosen.
     chosen: Chosen,
     /// Whether a pose stage has run (`T0`, the generators and `J_x` are those of a pose).
@@ -70,7 +72,12 @@ impl ArmStaticsData {
     /// The equilibrium set of the current pose if it was already computed (by a policy or by
     /// [`ArmStatics::equilibrium_set`]).
     pub fn cached_equilibrium_set(&self) -> Option<&EquilibriumSet> {
-        self.set.as_ref()
+        self.current_set()
+    }
+
+    /// The set if it is the current pose's.
+    fn current_set(&self) -> Option<&EquilibriumSet> {
+        self.set.as_ref().filter(|_| self.set_current)
     }
 }
 
@@ -151,6 +158,7 @@ impl ArmStatics {
             tensions: vec![0.0; self.cable_count()],
             distribution: None,
             set: None,
+            set_current: false,
             chosen: Chosen::Nothing,
             posed: false,
         }
@@ -206,7 +214,7 @@ impl ArmStatics {
         f0: &Vector6<f64>,
     ) -> Result<(), StaticsError> {
         data.posed = false;
-        data.set = None;
+        data.set_current = false;
         data.distribution = None;
         data.chosen = Chosen::Nothing;
         equilibrium_torques(robot, rdata, &mut data.joint_end, f0, &mut data.t0)?;
@@ -263,6 +271,7 @@ impl ArmStatics {
             }
             TensionChoice::Policy(policy) => {
                 self.cache_equilibrium_set(routing_data, data)?;
+                // Current: the line above computed it for this pose.
                 let Some(set) = data.set.as_ref() else {
                     return Err(StaticsError::NoPose);
                 };
@@ -322,7 +331,7 @@ impl ArmStatics {
         if distal.is_empty() || self.cache_equilibrium_set(routing_data, data).is_err() {
             return infeasible;
         }
-        let Some(set) = data.set.as_ref() else { return infeasible };
+        let Some(set) = data.current_set() else { return infeasible };
         let mut scratch = vec![0.0; self.cable_count()];
         let policy = TensionPolicy::Safest;
         if distribute_with_policy(set, policy, &self.groups, &self.cable_names, &mut scratch)
@@ -349,20 +358,22 @@ impl ArmStatics {
         if !data.posed {
             return Err(StaticsError::NoPose);
         }
-        if data.set.is_none() {
-            data.set = Some(EquilibriumSet::new(
-                routing_data.jacobian()?,
-                &data.t0,
-                &self.cable_limits,
-                &self.groups,
-            )?);
+        if !data.set_current {
+            let (jacobian, t0) = (routing_data.jacobian()?, &data.t0);
+            let (limits, groups) = (&self.cable_limits, &self.groups);
+            match data.set.as_mut() {
+                Some(set) => set.rebuild(jacobian, t0, limits, groups)?,
+                None => data.set = Some(EquilibriumSet::new(jacobian, t0, limits, groups)?),
+            }
+            data.set_current = true;
         }
         Ok(())
     }
 
     /// The equilibrium set `f = f_p + N λ` at the last pose (its `T0` in `data`), with every
-    /// cable's limits: computed at its first use after the pose stage (an SVD of `J_c`,
-    /// which allocates), then kept in `data` for every later tension stage of the pose.
+    /// cable's limits: computed at its first use after the pose stage (in the last pose's
+    /// buffers: [`EquilibriumSet::rebuild`]), then kept in `data` for every later tension stage
+    /// of the pose.
     ///
     /// # Errors
     /// [`StaticsError::NoPose`]; as [`EquilibriumSet::new`].
@@ -372,7 +383,7 @@ impl ArmStatics {
         data: &'d mut ArmStaticsData,
     ) -> Result<&'d EquilibriumSet, StaticsError> {
         self.cache_equilibrium_set(routing_data, data)?;
-        data.set.as_ref().ok_or(StaticsError::NoPose)
+        data.current_set().ok_or(StaticsError::NoPose)
     }
 
     /// [`check_balance`] on `J_c` and the cable limits.

@@ -38,7 +38,7 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 
 use crate::error::{NoEquilibrium, NoEquilibriumCause, StaticsError};
-use crate::set_block::{Block, BlockSet, copy_matrix};
+use crate::set_block::{Block, BlockScratch, copy_matrix, zeroed};
 
 /// The relative equilibrium residual `|T0 + J_cᵀ f| / |T0|` accepted as balance.
 pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-9;
@@ -49,10 +49,12 @@ pub(crate) const NAMED_SHARE: f64 = 0.1;
 
 /// The equilibrium set `f = f_p + N λ` of a cable set under a load, and its tension limits.
 ///
-/// Built per configuration by [`EquilibriumSet::new`] (it allocates; an SVD of each block of
-/// `J_c` that is not a three-cable joint); the
-/// tension policies of [`crate::TensionPolicy`] choose a point of it.
-#[derive(Debug, PartialEq)]
+/// Built per configuration by [`EquilibriumSet::new`], or rebuilt into the buffers of the last
+/// configuration's by [`EquilibriumSet::rebuild`] (no allocation for an arm whose blocks all
+/// have a closed form; an SVD of each block of `J_c` that is not a three-cable joint or a
+/// routed chain of them); the tension policies of [`crate::TensionPolicy`] choose a point of
+/// it.
+#[derive(Debug)]
 pub struct EquilibriumSet {
     particular: Vec<f64>,
     null: Mat<f64>,
@@ -61,14 +63,40 @@ pub struct EquilibriumSet {
     /// The independent blocks of `J_c` with `J_c⁺` on each.
     blocks: Vec<Block>,
     dof: usize,
+    /// Buffers of the rebuild (not part of the set's value).
+    scratch: SetScratch,
 }
 
-/// The independent blocks of `J_c` (m × dof): the connected components of the DOFs linked by
-/// the cables that move them (a non-zero `J_c[c, d]`), each with its cables (base first). A
-/// cable that moves no DOF is a block of its own with no DOFs; so is a DOF no cable moves.
-fn independent_blocks(jacobian: MatRef<'_, f64>) -> Vec<(Vec<usize>, Vec<usize>)> {
+/// The buffers of [`EquilibriumSet::rebuild`].
+#[derive(Debug, Default)]
+struct SetScratch {
+    /// Union–find parents of the DOFs, and the block of each root.
+    parent: Vec<usize>,
+    slot: Vec<usize>,
+    /// Each cable's first DOF it moves.
+    first: Vec<Option<usize>>,
+    block: BlockScratch,
+    residual: Vec<f64>,
+}
+
+impl PartialEq for EquilibriumSet {
+    fn eq(&self, other: &EquilibriumSet) -> bool {
+        self.particular == other.particular
+            && self.null == other.null
+            && self.lower == other.lower
+            && self.upper == other.upper
+            && self.blocks == other.blocks
+            && self.dof == other.dof
+    }
+}
+
+/// The independent blocks of `J_c` (m × dof) into `blocks` (their buffers reused): the
+/// connected components of the DOFs linked by the cables that move them (a non-zero
+/// `J_c[c, d]`), each with its cables (base first), in the order of their first DOF. A cable
+/// that moves no DOF is a block of its own with no DOFs, after those; a DOF no cable moves is
+/// a block with no cables.
+fn independent_blocks(jacobian: MatRef<'_, f64>, blocks: &mut Vec<Block>, s: &mut SetScratch) {
     let (m, dof) = (jacobian.nrows(), jacobian.ncols());
-    let mut parent: Vec<usize> = (0..dof).collect();
     fn root(parent: &mut [usize], mut d: usize) -> usize {
         while parent[d] != d {
             parent[d] = parent[parent[d]];
@@ -76,43 +104,51 @@ fn independent_blocks(jacobian: MatRef<'_, f64>) -> Vec<(Vec<usize>, Vec<usize>)
         }
         d
     }
-    let first: Vec<Option<usize>> =
-        (0..m).map(|c| (0..dof).find(|&d| jacobian[(c, d)] != 0.0)).collect();
-    for (c, first) in first.iter().enumerate() {
+    s.parent.clear();
+    s.parent.extend(0..dof);
+    s.first.clear();
+    s.first.extend((0..m).map(|c| (0..dof).find(|&d| jacobian[(c, d)] != 0.0)));
+    for (c, first) in s.first.iter().enumerate() {
         let Some(a) = *first else { continue };
         for d in a + 1..dof {
             if jacobian[(c, d)] != 0.0 {
-                let (ra, rd) = (root(&mut parent, a), root(&mut parent, d));
-                parent[rd] = ra;
+                let (ra, rd) = (root(&mut s.parent, a), root(&mut s.parent, d));
+                s.parent[rd] = ra;
             }
         }
     }
-    let mut blocks: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::with_capacity(dof);
+    let mut used = 0;
+    let mut next = |blocks: &mut Vec<Block>| {
+        if used == blocks.len() {
+            blocks.push(Block::empty());
+        }
+        blocks[used].cables.clear();
+        blocks[used].dofs.clear();
+        used += 1;
+        used - 1
+    };
+    s.slot.clear();
+    s.slot.resize(dof, usize::MAX);
     for d in 0..dof {
-        let r = root(&mut parent, d);
-        match blocks.iter_mut().find(|b| b.0 == r) {
-            Some(b) => b.2.push(d),
-            None => {
-                // A universal joint's block: two DOFs, three cables (room for both, at once).
-                let mut dofs = Vec::with_capacity(2);
-                dofs.push(d);
-                blocks.push((r, Vec::with_capacity(3), dofs));
-            }
+        let r = root(&mut s.parent, d);
+        if s.slot[r] == usize::MAX {
+            s.slot[r] = next(blocks);
+        }
+        blocks[s.slot[r]].dofs.push(d);
+    }
+    for (c, first) in s.first.iter().enumerate() {
+        if let Some(d) = *first {
+            let r = root(&mut s.parent, d);
+            blocks[s.slot[r]].cables.push(c);
         }
     }
-    let mut lone = Vec::new();
-    for (c, first) in first.iter().enumerate() {
-        match first {
-            Some(d) => {
-                let r = root(&mut parent, *d);
-                if let Some(b) = blocks.iter_mut().find(|b| b.0 == r) {
-                    b.1.push(c);
-                }
-            }
-            None => lone.push((vec![c], Vec::new())),
+    for (c, first) in s.first.iter().enumerate() {
+        if first.is_none() {
+            let b = next(blocks);
+            blocks[b].cables.push(c);
         }
     }
-    blocks.into_iter().map(|(_, cables, dofs)| (cables, dofs)).chain(lone).collect()
+    blocks.truncate(used);
 }
 
 impl Clone for EquilibriumSet {
@@ -124,6 +160,7 @@ impl Clone for EquilibriumSet {
             upper: self.upper.clone(),
             blocks: self.blocks.clone(),
             dof: self.dof,
+            scratch: SetScratch::default(),
         }
     }
 
@@ -155,6 +192,32 @@ impl EquilibriumSet {
         limits: &[[f64; 2]],
         groups: &[Range<usize>],
     ) -> Result<EquilibriumSet, StaticsError> {
+        let mut set = EquilibriumSet {
+            particular: Vec::new(),
+            null: Mat::new(),
+            lower: Vec::new(),
+            upper: Vec::new(),
+            blocks: Vec::new(),
+            dof: 0,
+            scratch: SetScratch::default(),
+        };
+        set.rebuild(jacobian, t0, limits, groups)?;
+        Ok(set)
+    }
+
+    /// [`EquilibriumSet::new`] into this set's buffers: with the arm of the last build (the
+    /// same blocks), no allocation where every block has a closed form (module docs of
+    /// `set_block.rs`). On an error the set is left partly rebuilt: rebuild it again before use.
+    ///
+    /// # Errors
+    /// As [`EquilibriumSet::new`].
+    pub fn rebuild(
+        &mut self,
+        jacobian: MatRef<'_, f64>,
+        t0: &[f64],
+        limits: &[[f64; 2]],
+        groups: &[Range<usize>],
+    ) -> Result<(), StaticsError> {
         let (m, dof) = (jacobian.nrows(), jacobian.ncols());
         for (what, expected, got) in
             [("equilibrium torques T0", dof, t0.len()), ("tension limits", m, limits.len())]
@@ -168,51 +231,49 @@ impl EquilibriumSet {
         if !finite {
             return Err(StaticsError::NonFiniteInput { what: "cable Jacobian or T0" });
         }
-        let mut particular = vec![0.0; m];
-        let independent = independent_blocks(jacobian);
-        let mut null_columns: Vec<Vec<(usize, f64)>> = Vec::with_capacity(m);
-        let mut blocks = Vec::with_capacity(independent.len());
-        for (cables, dofs) in independent {
-            if cables.is_empty() {
-                continue; // DOFs no cable moves: the residual check below names them.
-            }
-            let set = BlockSet::new(jacobian, cables, dofs, t0, groups)?;
-            let cables = &set.block.cables;
-            for (&c, &f) in cables.iter().zip(&set.particular) {
-                particular[c] = f;
-            }
-            for column in &set.null_columns {
-                null_columns.push(cables.iter().copied().zip(column.iter().copied()).collect());
-            }
-            blocks.push(set.block);
+        let s = &mut self.scratch;
+        independent_blocks(jacobian, &mut self.blocks, s);
+        let mut columns = 0;
+        for block in &mut self.blocks {
+            block.fill(jacobian, t0, groups, &mut s.block)?;
+            columns += block.null.ncols();
         }
-        let mut null = Mat::zeros(m, null_columns.len());
-        for (i, column) in null_columns.iter().enumerate() {
-            for &(c, value) in column {
-                null[(c, i)] = value;
+        self.particular.clear();
+        self.particular.resize(m, 0.0);
+        zeroed(&mut self.null, m, columns);
+        let mut i = 0;
+        for block in &self.blocks {
+            for (r, &c) in block.cables.iter().enumerate() {
+                self.particular[c] = block.particular[r];
+            }
+            for k in 0..block.null.ncols() {
+                for (r, &c) in block.cables.iter().enumerate() {
+                    self.null[(c, i)] = block.null[(r, k)];
+                }
+                i += 1;
             }
         }
-        let set = EquilibriumSet {
-            null,
-            lower: limits.iter().map(|l| l[0]).collect(),
-            upper: limits.iter().map(|l| l[1]).collect(),
-            particular,
-            blocks,
-            dof,
-        };
+        self.lower.clear();
+        self.lower.extend(limits.iter().map(|l| l[0]));
+        self.upper.clear();
+        self.upper.extend(limits.iter().map(|l| l[1]));
+        self.dof = dof;
         // The residual T0 + J_cᵀ f_p: what the cables cannot produce.
-        let residual: Vec<f64> = (0..dof)
-            .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * set.particular[c]).sum::<f64>())
-            .collect();
-        let size = norm(&residual);
+        s.residual.clear();
+        s.residual.extend(
+            (0..dof).map(|d| {
+                t0[d] + (0..m).map(|c| jacobian[(c, d)] * self.particular[c]).sum::<f64>()
+            }),
+        );
+        let size = norm(&s.residual);
         if size > EQUILIBRIUM_TOLERANCE * norm(t0) + f64::MIN_POSITIVE {
-            let direction: Vec<f64> = residual.iter().map(|r| r / size).collect();
+            let direction: Vec<f64> = s.residual.iter().map(|r| r / size).collect();
             return Err(StaticsError::NoEquilibrium(Box::new(NoEquilibrium {
                 joints: joints_along(&direction, groups),
                 cause: NoEquilibriumCause::Unreachable { direction, torque: size },
             })));
         }
-        Ok(set)
+        Ok(())
     }
 
     /// The number of cables `m`.

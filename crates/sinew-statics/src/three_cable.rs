@@ -21,17 +21,15 @@
 
 use std::ops::Range;
 
-use faer::{Mat, MatRef};
+use crate::set_block::Block;
 
 /// The closed form of a three-cable joint is taken when its smallest singular value is at least
 /// this fraction of its largest.
 const CLOSED_FORM_CONDITION: f64 = 1e-6;
 
-/// `n` and `(Jᵀ)⁺` (3 × 2, rows by cable) of a 3 × 2 block, or `None` for a block too close to
-/// rank 1 (module docs).
-fn joint_pieces(j: MatRef<'_, f64>) -> Option<([f64; 3], [[f64; 2]; 3])> {
-    let a = [j[(0, 0)], j[(1, 0)], j[(2, 0)]];
-    let b = [j[(0, 1)], j[(1, 1)], j[(2, 1)]];
+/// `n` and `(Jᵀ)⁺` (3 × 2, rows by cable) of a 3 × 2 block of columns `a`, `b`, or `None` for a
+/// block too close to rank 1 (module docs).
+fn joint_pieces(a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [[f64; 2]; 3])> {
     let dot = |u: &[f64; 3], w: &[f64; 3]| u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
     let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
     let (aa, ab, bb) = (dot(&a, &a), dot(&a, &b), dot(&b, &b));
@@ -60,58 +58,94 @@ fn joint_pieces(j: MatRef<'_, f64>) -> Option<([f64; 3], [[f64; 2]; 3])> {
     Some((n, inverse))
 }
 
-/// The closed form of a 3 × 2 block: `(f_p, n, J⁺)` under the torques `t`, or `None` for
-/// another shape or a block too close to rank 1.
-pub(crate) fn three_cable_joint(
-    j: MatRef<'_, f64>,
-    t: &[f64],
-) -> Option<(Vec<f64>, Vec<f64>, Mat<f64>)> {
+/// The closed form of a 3 × 2 block (its `range` on entry) under the torques `t`: `f_p`, `n`
+/// and `J⁺` into the block; `false` (the block untouched) for another shape or a block too
+/// close to rank 1.
+pub(crate) fn three_cable_joint(block: &mut Block, t: &[f64]) -> bool {
+    let j = block.range.as_ref();
     if j.nrows() != 3 || j.ncols() != 2 {
-        return None;
+        return false;
     }
-    let (n, inverse) = joint_pieces(j)?;
-    let particular = (0..3).map(|c| -(inverse[c][0] * t[0] + inverse[c][1] * t[1])).collect();
-    Some((particular, n.to_vec(), Mat::from_fn(2, 3, |d, c| inverse[c][d])))
+    let column = |d: usize| [j[(0, d)], j[(1, d)], j[(2, d)]];
+    let Some((n, inverse)) = joint_pieces(column(0), column(1)) else { return false };
+    block.particular.clear();
+    block.particular.extend((0..3).map(|c| -(inverse[c][0] * t[0] + inverse[c][1] * t[1])));
+    block.null.resize_with(3, 1, |_, _| 0.0);
+    block.pseudo_inverse.resize_with(2, 3, |_, _| 0.0);
+    for c in 0..3 {
+        block.null[(c, 0)] = n[c];
+        for d in 0..2 {
+            block.pseudo_inverse[(d, c)] = inverse[c][d];
+        }
+    }
+    true
 }
 
-/// The routed arm's block-triangular closed form (module docs) of the block `j` (cables ×
-/// DOFs, the block's `dofs` global) under the torques `t` (on the block's DOFs), with the arm's
-/// joints `groups`: `(f_p, N's columns, J⁺)`, or `None` when the block does not have the shape
-/// (two DOFs per joint, three cables ending at each) or a joint's own block is too close to
-/// rank 1.
-#[allow(clippy::type_complexity)]
+/// The scratch of [`triangular`], kept with the set.
+#[derive(Debug, Default)]
+pub(crate) struct Triangular {
+    /// The cables that end at each joint.
+    ends: Vec<[usize; 3]>,
+    /// How many cables end at each joint.
+    counts: Vec<usize>,
+    /// Each joint's own `n` and `(B_lᵀ)⁺`.
+    pieces: Vec<([f64; 3], [[f64; 2]; 3])>,
+    /// `N`'s columns, m each, one after the other.
+    null: Vec<f64>,
+    /// Right-hand sides (dof) and a back-substituted vector (m).
+    rhs: Vec<f64>,
+    column: Vec<f64>,
+}
+
+/// The routed arm's block-triangular closed form (module docs) of `block` (its `range`, cables
+/// × DOFs, on entry; its `dofs` global) under the torques `t` (on the block's DOFs), with the
+/// arm's joints `groups`: `f_p`, `N`'s columns and `J⁺` into the block; `false` (the block's
+/// share untouched) when the block does not have the shape (two DOFs per joint, three cables
+/// ending at each) or a joint's own block is too close to rank 1.
 pub(crate) fn triangular(
-    j: MatRef<'_, f64>,
-    dofs: &[usize],
+    block: &mut Block,
     groups: &[Range<usize>],
     t: &[f64],
-) -> Option<(Vec<f64>, Vec<Vec<f64>>, Mat<f64>)> {
+    s: &mut Triangular,
+) -> bool {
+    let j = block.range.as_ref();
+    let dofs = &block.dofs;
     let (m, dof) = (j.nrows(), j.ncols());
     // The block's joints: consecutive pairs of its DOFs, each a whole joint of the arm.
     if dof % 2 != 0 || m != 3 * dof / 2 {
-        return None;
+        return false;
     }
     let joints = dof / 2;
     for l in 0..joints {
-        let g = groups.iter().find(|g| g.start == dofs[2 * l])?;
+        let Some(g) = groups.iter().find(|g| g.start == dofs[2 * l]) else { return false };
         if g.len() != 2 || dofs[2 * l + 1] != g.start + 1 {
-            return None;
+            return false;
         }
     }
     // Each cable's joint: that of its last non-zero DOF; three per joint.
-    let mut ends: Vec<Vec<usize>> = vec![Vec::new(); joints];
+    s.ends.clear();
+    s.ends.resize(joints, [0; 3]);
+    s.counts.clear();
+    s.counts.resize(joints, 0);
     for c in 0..m {
-        let last = (0..dof).rev().find(|&d| j[(c, d)] != 0.0)?;
-        ends[last / 2].push(c);
+        let Some(last) = (0..dof).rev().find(|&d| j[(c, d)] != 0.0) else { return false };
+        let l = last / 2;
+        if s.counts[l] == 3 {
+            return false;
+        }
+        s.ends[l][s.counts[l]] = c;
+        s.counts[l] += 1;
     }
-    if ends.iter().any(|e| e.len() != 3) {
-        return None;
+    if s.counts.iter().any(|&n| n != 3) {
+        return false;
     }
-    let mut pieces = Vec::with_capacity(joints);
-    for (l, cables) in ends.iter().enumerate() {
-        let own = Mat::from_fn(3, 2, |r, d| j[(cables[r], 2 * l + d)]);
-        pieces.push(joint_pieces(own.as_ref())?);
+    s.pieces.clear();
+    for (l, cables) in s.ends.iter().enumerate() {
+        let column = |d: usize| cables.map(|c| j[(c, 2 * l + d)]);
+        let Some(pieces) = joint_pieces(column(0), column(1)) else { return false };
+        s.pieces.push(pieces);
     }
+    let (ends, pieces) = (&s.ends, &s.pieces);
     // J_cᵀ f = r on the joints before `from`, from the tip down, with f already set on the
     // cables of joints `from..=upto` (and zero beyond).
     let solve = |r: &[f64], from: usize, upto: usize, f: &mut [f64]| {
@@ -129,51 +163,60 @@ pub(crate) fn triangular(
             }
         }
     };
-    let zero = vec![0.0; dof];
-    let mut null: Vec<Vec<f64>> = Vec::with_capacity(joints);
+    s.rhs.clear();
+    s.rhs.resize(dof, 0.0);
+    s.null.clear();
+    s.null.resize(m * joints, 0.0);
     for top in 0..joints {
+        let (done, rest) = s.null.split_at_mut(top * m);
+        let v = &mut rest[..m];
         // n_top on joint top's cables; the joints before balance its torques on them.
-        let mut v = vec![0.0; m];
         for (row, &c) in ends[top].iter().enumerate() {
             v[c] = pieces[top].0[row];
         }
-        solve(&zero, top, top, &mut v);
+        solve(&s.rhs, top, top, v);
         // Gram–Schmidt twice against the columns before.
         for _ in 0..2 {
-            for u in &null {
-                let along: f64 = u.iter().zip(&v).map(|(a, b)| a * b).sum();
+            for u in done.chunks_exact(m) {
+                let along: f64 = u.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
                 v.iter_mut().zip(u).for_each(|(x, y)| *x -= along * y);
             }
         }
         let size = v.iter().map(|x| x * x).sum::<f64>().sqrt();
         if !(size > 0.0 && size.is_finite()) {
-            return None;
+            return false;
         }
         v.iter_mut().for_each(|x| *x /= size);
-        null.push(v);
     }
+    let null = &s.null;
     let project = |f: &mut [f64]| {
-        for u in &null {
+        for u in null.chunks_exact(m) {
             let along: f64 = u.iter().zip(f.iter()).map(|(a, b)| a * b).sum();
             f.iter_mut().zip(u).for_each(|(x, y)| *x -= along * y);
         }
     };
-    let mut particular = vec![0.0; m];
-    let minus_t: Vec<f64> = t.iter().map(|v| -v).collect();
-    solve(&minus_t, joints, joints - 1, &mut particular);
-    project(&mut particular);
-    let mut pseudo_inverse = Mat::zeros(dof, m);
-    let mut unit = vec![0.0; dof];
-    let mut column = vec![0.0; m];
+    s.column.clear();
+    s.column.resize(m, 0.0);
+    s.rhs.iter_mut().zip(t).for_each(|(r, t)| *r = -t);
+    solve(&s.rhs, joints, joints - 1, &mut s.column);
+    project(&mut s.column);
+    block.particular.clone_from(&s.column);
+    block.pseudo_inverse.resize_with(dof, m, |_, _| 0.0);
     for d in 0..dof {
-        unit.fill(0.0);
-        unit[d] = 1.0;
-        column.fill(0.0);
-        solve(&unit, joints, joints - 1, &mut column);
-        project(&mut column);
-        for (c, v) in column.iter().enumerate() {
-            pseudo_inverse[(d, c)] = *v;
+        s.rhs.fill(0.0);
+        s.rhs[d] = 1.0;
+        s.column.fill(0.0);
+        solve(&s.rhs, joints, joints - 1, &mut s.column);
+        project(&mut s.column);
+        for (c, v) in s.column.iter().enumerate() {
+            block.pseudo_inverse[(d, c)] = *v;
         }
     }
-    Some((particular, null, pseudo_inverse))
+    block.null.resize_with(m, joints, |_, _| 0.0);
+    for (i, u) in null.chunks_exact(m).enumerate() {
+        for (c, v) in u.iter().enumerate() {
+            block.null[(c, i)] = *v;
+        }
+    }
+    true
 }

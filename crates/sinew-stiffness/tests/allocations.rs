@@ -17,6 +17,9 @@ use sinew_testkit::{cdhrm5, config};
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
 
+/// The counter is global: the tests of this binary run one at a time.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
     let mut v = Vec::new();
     for (model, solver) in
@@ -37,6 +40,7 @@ fn arms() -> Vec<(String, Robot, Routing, EndSolver)> {
 
 #[test]
 fn evaluating_the_pipeline_allocates_nothing() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     assert_counting();
     for (name, robot, routing, solver) in arms() {
         let n = robot.dof();
@@ -74,5 +78,41 @@ fn evaluating_the_pipeline_allocates_nothing() {
             }
         });
         assert_eq!(allocations, 0, "{name}: {allocations} allocations in 40 evaluations");
+    }
+}
+
+/// The equilibrium set of each new pose is rebuilt in the last pose's buffers: no allocation,
+/// and the set a fresh build gives (closed forms in both models: one cross product per joint
+/// when decoupled, the block-triangular basis when routed).
+#[test]
+fn the_equilibrium_set_of_a_new_pose_allocates_nothing() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    assert_counting();
+    for (name, robot, routing, _) in arms() {
+        let n = robot.dof();
+        let model = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut data = ArmStiffnessData::new(&model);
+        let mut rng = config::rng(23);
+        let centre: Vec<f64> = if n == 10 { cdhrm5::LOADED_POSE.to_vec() } else { vec![0.05; n] };
+        let qs: Vec<Vec<f64>> = (0..6).map(|_| config::near(&centre, 0.05, &mut rng)).collect();
+        let f = if n == 10 { 5.0 } else { 0.01 };
+        let f0 = Vector6::new(0.0, f, 0.5 * f, 0.0, 0.0, 0.0);
+        model.set_pose(&mut data, &qs[0], &f0).unwrap();
+        model.equilibrium_set(&mut data).unwrap();
+        for q in &qs[1..] {
+            let (allocations, ()) = count(|| {
+                model.set_pose(&mut data, q, &f0).unwrap();
+                model.equilibrium_set(&mut data).unwrap();
+            });
+            assert_eq!(allocations, 0, "{name}: {allocations} allocations for a new pose's set");
+            let fresh = sinew_statics::EquilibriumSet::new(
+                data.cables.jacobian().unwrap(),
+                &data.statics.t0,
+                model.statics().cable_limits(),
+                model.statics().joint_groups(),
+            )
+            .unwrap();
+            assert_eq!(model.equilibrium_set(&mut data).unwrap(), &fresh, "{name}");
+        }
     }
 }
