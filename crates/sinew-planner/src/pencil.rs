@@ -66,22 +66,27 @@ impl Pencil {
         let routing = arm.routing();
         let dof = arm.dof();
         self.size(dof, set.dimension());
-        // Σ f_p,c H_c, then K_i + K_W entry by entry.
-        sd.cables.add_weighted_hessians(routing, set.particular(), self.a0.as_mut())?;
+        // Σ_c f_p,c H_c and every A_i = Σ_c N_ci H_c in one pass over the segments' Hessians
+        // (each entry summed in segment order, as `add_weighted_hessians` does), then K_i + K_W
+        // entry by entry.
+        let null = set.null_basis();
+        let particular = set.particular();
+        for (seg, h) in sd.cables.segment_hessians(routing)?.iter() {
+            let (lo, n, c) = (seg.dofs.start, seg.dofs.len(), seg.cable);
+            if n == 0 || h.len() != n * n || c >= set.cable_count() {
+                continue;
+            }
+            add_block(&mut self.a0, lo, n, h, particular[c]);
+            for (i, a) in self.ai.iter_mut().enumerate() {
+                add_block(a, lo, n, h, null[(c, i)]);
+            }
+        }
         self.k_w.copy_from(sd.k_w());
         let k_inherent = sd.k_inherent();
         for c in 0..dof {
             for r in 0..dof {
                 self.a0[(r, c)] += k_inherent[(r, c)] + self.k_w[(r, c)];
             }
-        }
-        let null = set.null_basis();
-        self.weights.resize(set.cable_count(), 0.0);
-        for (i, a) in self.ai.iter_mut().enumerate() {
-            for (c, w) in self.weights.iter_mut().enumerate() {
-                *w = null[(c, i)];
-            }
-            sd.cables.add_weighted_hessians(routing, &self.weights, a.as_mut())?;
         }
         self.copy_j_x(sd.j_x());
         self.fill_spans(arm, set);
@@ -323,5 +328,19 @@ impl End {
         });
         let value = 2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>();
         Some((value, pencil.forms(z.as_ref())))
+    }
+}
+
+/// `out[lo.., lo..] += w · h` for a segment's Hessian block `h` (n × n, column-major), column
+/// slice by column slice (`n ≥ 1`); nothing for `w = 0` (a cable outside a null column).
+fn add_block(out: &mut Mat<f64>, lo: usize, n: usize, h: &[f64], w: f64) {
+    if w == 0.0 {
+        return;
+    }
+    for (k, h) in h.chunks_exact(n).enumerate() {
+        let col = &mut out.col_as_slice_mut(lo + k)[lo..lo + n];
+        for (v, h) in col.iter_mut().zip(h) {
+            *v += w * h;
+        }
     }
 }
