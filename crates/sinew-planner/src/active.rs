@@ -26,15 +26,15 @@
 //! `y ≥ 0` (the margin's multiplier is 0, so the margin only needs to hold, which one Cholesky
 //! trial checks). An answer is accepted only inside every row (to [`ROUNDING`]).
 
-use nalgebra::{DMatrix, DVector, Vector6};
+use nalgebra::Vector6;
 
-use crate::blocks::base;
-use crate::dense::cholesky;
+use crate::blocks::base_into;
+use crate::dense::{cholesky, cholesky_solve, dot};
 use crate::frame::Frame;
 use crate::ipm::Answer;
 use crate::problem::{Objective, PlanSettings, Requirements};
-use crate::program::{Duals, Smooth, upper_bound};
-use crate::smooth::{EndObjective, Kind};
+use crate::program::{Duals, Sdp, Smooth, upper_bound};
+use crate::smooth::{EndBuffers, EndObjective, Kind};
 
 /// A row is active at the mapped point when its slack is below this (the frame's units: each
 /// row's largest coefficient is 1 and `x ∈ [−1, 1]`).
@@ -51,37 +51,82 @@ const ROUNDING: f64 = 1e-10;
 /// the point is stationary on its active set.
 const STATIONARY: f64 = 1e-9;
 
+/// The buffers of the warm step, kept in the planner's workspace: a step along a trajectory
+/// allocates none of them again.
+#[derive(Debug, Default)]
+pub(crate) struct WarmWork {
+    /// The mapped previous answer `x₀` (filled by the caller).
+    pub(crate) mapped: Vec<f64>,
+    /// The iterate (moved into the answer; the caller returns it).
+    pub(crate) x: Vec<f64>,
+    end: EndBuffers,
+    sdp: Option<Sdp>,
+    active: Vec<usize>,
+    gradient: Vec<f64>,
+    hessian: Vec<f64>,
+    s: Vec<f64>,
+    a: Vec<f64>,
+    /// The KKT matrix (row-major) and its right-hand side, then `(d, y)`.
+    kkt: Vec<f64>,
+    rhs: Vec<f64>,
+    /// Every row's multiplier, and the least-squares system of the active ones.
+    y: Vec<f64>,
+    gram: Vec<f64>,
+    /// Rows and slacks, for [`active_rows_into`].
+    pairs: Vec<(usize, f64)>,
+}
+
+impl WarmWork {
+    /// The scratch of [`active_rows_into`].
+    pub(crate) fn pairs(&mut self) -> &mut Vec<(usize, f64)> {
+        &mut self.pairs
+    }
+}
+
 /// The objective of the step.
+#[allow(clippy::large_enum_variant)] // one per warm step, on the stack: no allocation
 enum Goal<'a> {
-    Smooth(Box<EndObjective<'a>>),
-    /// `c₀ + cᵀx`.
-    Linear(f64, Vec<f64>),
+    Smooth(EndObjective<'a>),
+    /// `−Σ f = −total − sumsᵀx` (least tension).
+    Linear,
 }
 
 impl Goal<'_> {
-    fn evaluate(&mut self, x: &[f64], gradient: &mut [f64], hessian: &mut [f64]) -> Option<f64> {
+    fn evaluate(
+        &mut self,
+        frame: &Frame,
+        x: &[f64],
+        gradient: &mut [f64],
+        hessian: &mut [f64],
+    ) -> Option<f64> {
         match self {
             Goal::Smooth(s) => s.evaluate(x, gradient, hessian),
-            Goal::Linear(c0, c) => {
-                gradient.copy_from_slice(c);
+            Goal::Linear => {
+                gradient.iter_mut().zip(&frame.sums).for_each(|(g, s)| *g = -s);
                 hessian.fill(0.0);
-                Some(*c0 + c.iter().zip(x).map(|(a, b)| a * b).sum::<f64>())
+                Some(-frame.total - dot(&frame.sums, x))
             }
         }
     }
 }
 
 /// The rows active at `x` (slack below [`ACTIVE_SLACK`]), tightest first, at most one per
-/// free coordinate: the active set a plan leaves to the next step's warm start.
-pub(crate) fn active_rows(frame: &Frame, x: &[f64]) -> Vec<usize> {
-    let k = frame.vars();
-    let mut rows: Vec<(usize, f64)> = (0..frame.rhs.len())
-        .map(|r| (r, slack(frame, x, r)))
-        .filter(|(_, s)| *s < ACTIVE_SLACK)
-        .collect();
-    rows.sort_by(|a, b| a.1.total_cmp(&b.1));
-    rows.truncate(k);
-    rows.into_iter().map(|(r, _)| r).collect()
+/// free coordinate, into `out` (`pairs` a scratch): the active set a plan leaves to the next
+/// step's warm start.
+pub(crate) fn active_rows_into(
+    frame: &Frame,
+    x: &[f64],
+    out: &mut Vec<usize>,
+    pairs: &mut Vec<(usize, f64)>,
+) {
+    pairs.clear();
+    pairs.extend(
+        (0..frame.rhs.len()).map(|r| (r, slack(frame, x, r))).filter(|(_, s)| *s < ACTIVE_SLACK),
+    );
+    pairs.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    pairs.truncate(frame.vars());
+    out.clear();
+    out.extend(pairs.iter().map(|(r, _)| *r));
 }
 
 /// `h_r − G_r x`.
@@ -93,7 +138,8 @@ fn slack(frame: &Frame, x: &[f64], r: usize) -> f64 {
 /// The warm answer from the mapped previous answer `x0` and the previous active set
 /// `previous` (`None` when this frame's rows are not the previous frame's: then the rows
 /// active at `x0`), or the evaluations spent when the step does not apply or is not
-/// certified within the tolerance (module docs).
+/// certified within the tolerance (module docs). The buffers are `work`'s; the answer's `x` is
+/// `work.x`, moved.
 pub(crate) fn warm(
     frame: &Frame,
     objective: Objective,
@@ -101,32 +147,68 @@ pub(crate) fn warm(
     settings: &PlanSettings,
     x0: &[f64],
     previous: Option<&[usize]>,
+    work: &mut WarmWork,
 ) -> Result<Answer, usize> {
     if requirements.k_min.is_some() || requirements.k_des.is_some() {
         return Err(0);
     }
-    let k = frame.vars();
+    let end = std::mem::take(&mut work.end);
     let mut goal = match objective {
-        Objective::LeastTension => {
-            Goal::Linear(-frame.total, frame.sums.iter().map(|s| -s).collect())
-        }
+        Objective::LeastTension => Goal::Linear,
         Objective::StiffnessAlong(u) => {
             let w = Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0);
-            Goal::Smooth(Box::new(EndObjective::new(frame, Kind::Along(w), 1.0)))
+            Goal::Smooth(EndObjective::reusing(frame, Kind::Along(w), 1.0, end))
         }
-        Objective::Volume => Goal::Smooth(Box::new(EndObjective::new(frame, Kind::Volume, 1.0))),
-        Objective::MinStiffness | Objective::ComplianceAlong(_) => return Err(0),
+        Objective::Volume => Goal::Smooth(EndObjective::reusing(frame, Kind::Volume, 1.0, end)),
+        Objective::MinStiffness | Objective::ComplianceAlong(_) => {
+            work.end = end;
+            return Err(0);
+        }
     };
-    let sdp = base(frame, 0);
-    let rows = frame.rhs.len();
-    let mut active = match previous {
-        Some(previous) => previous.to_vec(),
-        None => active_rows(frame, x0),
+    let result = steps(frame, objective, requirements, settings, x0, previous, &mut goal, work);
+    if let Goal::Smooth(smooth) = goal {
+        work.end = smooth.into_buffers();
+    }
+    result
+}
+
+/// The steps of [`warm`] with its objective `goal`.
+#[allow(clippy::too_many_arguments)]
+fn steps(
+    frame: &Frame,
+    objective: Objective,
+    requirements: &Requirements,
+    settings: &PlanSettings,
+    x0: &[f64],
+    previous: Option<&[usize]>,
+    goal: &mut Goal<'_>,
+    work: &mut WarmWork,
+) -> Result<Answer, usize> {
+    let (k, n) = (frame.vars(), frame.n);
+    let sdp = work.sdp.get_or_insert_with(Sdp::default);
+    base_into(frame, 0, sdp);
+    match previous {
+        Some(previous) => {
+            work.active.clear();
+            work.active.extend_from_slice(previous);
+        }
+        None => active_rows_into(frame, x0, &mut work.active, &mut work.pairs),
+    }
+    let active = &mut work.active;
+    work.x.clear();
+    work.x.extend_from_slice(x0);
+    let x = &mut work.x;
+    let sized = |v: &mut Vec<f64>, len: usize| {
+        v.clear();
+        v.resize(len, 0.0);
     };
-    let mut x = x0.to_vec();
-    let (mut gradient, mut hessian) = (vec![0.0; k], vec![0.0; k * k]);
-    let mut s = vec![0.0; rows];
-    let mut a = vec![0.0; frame.n * frame.n];
+    sized(&mut work.gradient, k);
+    sized(&mut work.hessian, k * k);
+    sized(&mut work.s, frame.rhs.len());
+    sized(&mut work.a, n * n);
+    let (gradient, hessian, s, a) =
+        (&mut work.gradient, &mut work.hessian, &mut work.s, &mut work.a);
+    let (kkt, rhs, y, gram) = (&mut work.kkt, &mut work.rhs, &mut work.y, &mut work.gram);
     // The objective's scale: its value at the first point (the gap's floor 1e-9 of it, 1 in
     // log units for the volume).
     let mut scale = None;
@@ -136,25 +218,27 @@ pub(crate) fn warm(
         }
         if active.len() == k {
             // As many rows as coordinates: their vertex, whatever the objective.
-            let d = newton(frame, &x, &gradient, &hessian, &active).ok_or(step)?.0;
-            x.iter_mut().zip(&d).for_each(|(xa, da)| *xa += da);
+            if !newton(frame, x, gradient, hessian, active, kkt, rhs) {
+                return Err(step);
+            }
+            x.iter_mut().zip(&rhs[..k]).for_each(|(xa, da)| *xa += da);
         }
         // The margin must hold (its multiplier is 0): one Cholesky trial.
-        frame.a_at(&x, &mut a);
-        for i in 0..frame.n {
-            a[i * frame.n + i] -= requirements.margin;
+        frame.a_at(x, a);
+        for i in 0..n {
+            a[i * n + i] -= requirements.margin;
         }
-        if !cholesky(&mut a, frame.n) {
+        if !cholesky(a, n) {
             return Err(step);
         }
-        let value = goal.evaluate(&x, &mut gradient, &mut hessian).ok_or(step)?;
+        let value = goal.evaluate(frame, x, gradient, hessian).ok_or(step)?;
         let (scale, floor) = *scale.get_or_insert_with(|| match objective {
             Objective::Volume => (value.abs().max(1.0), 1.0 / value.abs().max(1.0)),
             _ => (value.abs().max(1e-12), 1e-9),
         });
         let value = value / scale;
         gradient.iter_mut().chain(hessian.iter_mut()).for_each(|v| *v /= scale);
-        sdp.slacks(&x, &mut s);
+        sdp.slacks(x, s);
         // The most violated row, if any.
         let violated = s
             .iter()
@@ -162,15 +246,21 @@ pub(crate) fn warm(
             .fold((None, -ROUNDING), |best, (r, &v)| if v < best.1 { (Some(r), v) } else { best })
             .0;
         if violated.is_none() {
-            let duals = Duals { y: multipliers(frame, &gradient, &active), z: Vec::new() };
-            let upper = upper_bound(&sdp, &x, value, &gradient, &s, std::iter::empty(), &duals);
+            multipliers(frame, gradient, active, y, gram);
+            let duals = Duals { y: std::mem::take(y), z: Vec::new() };
+            let upper = upper_bound(sdp, x, value, gradient, s, std::iter::empty(), &duals);
+            *y = duals.y;
             if upper - value <= settings.relative_gap * value.abs().max(floor) {
+                let x = std::mem::take(x);
                 return Ok(Answer { x, upper: upper * scale, iterations: step + 1 });
             }
         }
-        let (d, y) = newton(frame, &x, &gradient, &hessian, &active).ok_or(step + 1)?;
+        if !newton(frame, x, gradient, hessian, active, kkt, rhs) {
+            return Err(step + 1);
+        }
+        let (d, multipliers) = rhs.split_at(k);
         if d.iter().fold(0.0_f64, |m, v| m.max(v.abs())) > STATIONARY {
-            x.iter_mut().zip(&d).for_each(|(xa, da)| *xa += da);
+            x.iter_mut().zip(d).for_each(|(xa, da)| *xa += da);
             continue;
         }
         // Stationary on W and not certified: a violated row joins W, else the row with the
@@ -179,7 +269,7 @@ pub(crate) fn warm(
             Some(r) if active.len() < k => active.push(r),
             Some(_) => return Err(step + 1),
             None => {
-                let (i, least) = y
+                let (i, least) = multipliers
                     .iter()
                     .enumerate()
                     .fold((0, 0.0), |best, (i, &v)| if v < best.1 { (i, v) } else { best });
@@ -193,59 +283,105 @@ pub(crate) fn warm(
     Err(MAX_STEPS)
 }
 
-/// The Newton step `d` and the active rows' multipliers `y` (module docs); `None` when the
-/// system is singular.
+/// The Newton step `d` and the active rows' multipliers `y` (module docs) into `rhs` as
+/// `(d, y)`, the KKT matrix in `kkt`; `false` when the system is singular.
 fn newton(
     frame: &Frame,
     x: &[f64],
     gradient: &[f64],
     hessian: &[f64],
     active: &[usize],
-) -> Option<(Vec<f64>, Vec<f64>)> {
+    kkt: &mut Vec<f64>,
+    rhs: &mut Vec<f64>,
+) -> bool {
     let k = frame.vars();
     let p = active.len();
+    let size = k + p;
     let largest = (0..k).map(|a| hessian[a * k + a].abs()).fold(0.0, f64::max);
     let epsilon = 1e-9 * largest.max(1e-3);
-    let mut kkt = DMatrix::zeros(k + p, k + p);
-    let mut rhs = DVector::zeros(k + p);
+    kkt.clear();
+    kkt.resize(size * size, 0.0);
+    rhs.clear();
+    rhs.resize(size, 0.0);
     for a in 0..k {
         for b in 0..k {
-            kkt[(a, b)] = -hessian[a * k + b];
+            kkt[a * size + b] = -hessian[a * k + b];
         }
-        kkt[(a, a)] += epsilon;
+        kkt[a * size + a] += epsilon;
         rhs[a] = gradient[a];
     }
     for (i, &r) in active.iter().enumerate() {
         let row = &frame.rows[r * k..r * k + k];
         for (a, v) in row.iter().enumerate() {
-            kkt[(k + i, a)] = *v;
-            kkt[(a, k + i)] = *v;
+            kkt[(k + i) * size + a] = *v;
+            kkt[a * size + k + i] = *v;
         }
         rhs[k + i] = slack(frame, x, r);
     }
-    let solution = kkt.lu().solve(&rhs)?;
-    if !solution.iter().all(|v| v.is_finite()) {
-        return None;
-    }
-    let d = solution.rows(0, k).iter().copied().collect();
-    Some((d, solution.rows(k, p).iter().copied().collect()))
+    lu_solve(kkt, size, rhs) && rhs.iter().all(|v| v.is_finite())
 }
 
-/// Every row's multiplier for the bound: the active rows' by least squares on `G_Wᵀ y = g`,
-/// clipped at 0, the others' 0.
-fn multipliers(frame: &Frame, gradient: &[f64], active: &[usize]) -> Vec<f64> {
-    let k = frame.vars();
-    let mut y = vec![0.0; frame.rhs.len()];
-    if active.is_empty() {
-        return y;
-    }
-    let g = DMatrix::from_fn(active.len(), k, |i, a| frame.rows[active[i] * k + a]);
-    let gram = &g * g.transpose();
-    if let Some(c) = gram.cholesky() {
-        let solved = c.solve(&(&g * DVector::from_column_slice(gradient)));
-        for (&r, v) in active.iter().zip(solved.iter()) {
-            y[r] = v.max(0.0);
+/// `A⁻¹ b` into `b` by Gaussian elimination with partial pivoting (`a` n × n row-major,
+/// overwritten); `false` when a pivot is zero (`a` singular).
+fn lu_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> bool {
+    for c in 0..n {
+        let pivot =
+            (c..n).fold(c, |p, r| if a[r * n + c].abs() > a[p * n + c].abs() { r } else { p });
+        if a[pivot * n + c] == 0.0 {
+            return false;
+        }
+        if pivot != c {
+            for j in 0..n {
+                a.swap(pivot * n + j, c * n + j);
+            }
+            b.swap(pivot, c);
+        }
+        let d = a[c * n + c];
+        for r in c + 1..n {
+            let f = a[r * n + c] / d;
+            if f == 0.0 {
+                continue;
+            }
+            for j in c + 1..n {
+                a[r * n + j] -= f * a[c * n + j];
+            }
+            b[r] -= f * b[c];
         }
     }
-    y
+    for c in (0..n).rev() {
+        let tail: f64 = (c + 1..n).map(|j| a[c * n + j] * b[j]).sum();
+        b[c] = (b[c] - tail) / a[c * n + c];
+    }
+    true
+}
+
+/// Every row's multiplier for the bound into `y`: the active rows' by least squares on
+/// `G_Wᵀ y = g`, clipped at 0, the others' 0 (`gram` a scratch).
+fn multipliers(
+    frame: &Frame,
+    gradient: &[f64],
+    active: &[usize],
+    y: &mut Vec<f64>,
+    gram: &mut Vec<f64>,
+) {
+    let k = frame.vars();
+    let (p, rows) = (active.len(), frame.rhs.len());
+    y.clear();
+    y.resize(rows + p, 0.0);
+    if p > 0 {
+        let row = |i: usize| &frame.rows[active[i] * k..active[i] * k + k];
+        gram.clear();
+        gram.extend((0..p * p).map(|e| dot(row(e / p), row(e % p))));
+        let (every, solved) = y.split_at_mut(rows);
+        for (i, v) in solved.iter_mut().enumerate() {
+            *v = dot(row(i), gradient);
+        }
+        if cholesky(gram, p) {
+            cholesky_solve(gram, p, solved);
+            for (&r, v) in active.iter().zip(solved.iter()) {
+                every[r] = v.max(0.0);
+            }
+        }
+    }
+    y.truncate(rows);
 }

@@ -24,7 +24,7 @@ pub(crate) struct Evaluated {
 /// [`PlanError::NoEndStiffness`] for a `K_fd` objective where `K_x` does not exist.
 pub(crate) fn plan_at(
     objective: Objective,
-    (lambda, tensions): (&[f64], Vec<f64>),
+    (lambda, tensions): (Vec<f64>, Vec<f64>),
     at: Evaluated,
     upper: f64,
     iterations: usize,
@@ -56,7 +56,7 @@ pub(crate) fn plan_at(
         value,
         gap,
         total_tension: total,
-        lambda: lambda.to_vec(),
+        lambda,
         tensions,
         levels,
         k_fd,

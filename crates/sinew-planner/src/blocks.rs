@@ -24,29 +24,30 @@ pub(crate) struct Floor {
 
 /// The base problem: the rows (with `extra` zero columns) and the box, no block.
 pub(crate) fn base(f: &Frame, extra: usize) -> Sdp {
+    let mut sdp = Sdp::default();
+    base_into(f, extra, &mut sdp);
+    sdp
+}
+
+/// [`base`] into `sdp`'s buffers (its blocks and epigraph removed).
+pub(crate) fn base_into(f: &Frame, extra: usize, sdp: &mut Sdp) {
     let k = f.vars();
     let width = k + extra;
-    let mut rows = Vec::with_capacity(f.rhs.len() * width);
+    sdp.c0 = 0.0;
+    sdp.c.clear();
+    sdp.c.resize(width, 0.0);
+    sdp.rows.clear();
     for r in 0..f.rhs.len() {
-        rows.extend_from_slice(&f.rows[r * k..r * k + k]);
-        rows.extend(std::iter::repeat_n(0.0, extra));
+        sdp.rows.extend_from_slice(&f.rows[r * k..r * k + k]);
+        sdp.rows.extend(std::iter::repeat_n(0.0, extra));
     }
-    let mut lo = vec![-1.0; width];
-    let mut hi = vec![1.0; width];
-    for e in k..width {
-        lo[e] = f64::NEG_INFINITY;
-        hi[e] = f64::INFINITY;
-    }
-    Sdp {
-        c0: 0.0,
-        c: vec![0.0; width],
-        rows,
-        rhs: f.rhs.clone(),
-        blocks: Vec::new(),
-        lo,
-        hi,
-        epigraph: None,
-    }
+    sdp.rhs.clone_from(&f.rhs);
+    sdp.blocks.clear();
+    sdp.lo.clear();
+    sdp.lo.extend((0..width).map(|e| if e < k { -1.0 } else { f64::NEG_INFINITY }));
+    sdp.hi.clear();
+    sdp.hi.extend((0..width).map(|e| if e < k { 1.0 } else { f64::INFINITY }));
+    sdp.epigraph = None;
 }
 
 /// `(A(x) − shift I)/a_scale`, with `−(t_scale/a_scale) I` for an epigraph variable.

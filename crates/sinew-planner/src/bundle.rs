@@ -71,6 +71,15 @@ impl Linear {
         Linear { k, rows: Vec::with_capacity(k * capacity), rhs: Vec::with_capacity(capacity) }
     }
 
+    /// No rows, in `k` coordinates, with room for `capacity` rows (this one's buffers kept).
+    pub(crate) fn clear(&mut self, k: usize, capacity: usize) {
+        self.k = k;
+        self.rows.clear();
+        self.rows.reserve(k * capacity);
+        self.rhs.clear();
+        self.rhs.reserve(capacity);
+    }
+
     /// Adds the row `a·x ≤ rhs` (`a` of `k` coordinates).
     pub(crate) fn push(&mut self, a: impl IntoIterator<Item = f64>, rhs: f64) {
         let before = self.rows.len();
@@ -88,14 +97,21 @@ impl Linear {
     /// each cable's two limit rows bound the one coordinate of its joint, so three cables'
     /// six rows become two.
     pub(crate) fn merged(&self) -> Linear {
+        let mut out = Linear::new(self.k, self.rhs.len());
+        self.merged_into(&mut out, &mut Vec::new());
+        out
+    }
+
+    /// [`Linear::merged`] into `out`'s buffers, with `keys` a scratch.
+    pub(crate) fn merged_into(&self, out: &mut Linear, keys: &mut Vec<usize>) {
         let k = self.k;
-        let mut out = Linear::new(k, self.rhs.len());
+        out.clear(k, self.rhs.len());
         // Each kept row's first coordinate above `KEY` (rows scaled to a largest entry of 1):
         // only rows with the same key are compared in full. Rows within 1e-12 of each other
         // share it unless an entry lies within 1e-12 of `KEY`, and then they are both kept,
         // which leaves the polytope as it is.
         const KEY: f64 = 1e-6;
-        let mut keys: Vec<usize> = Vec::with_capacity(self.rhs.len());
+        keys.clear();
         for (row, rhs) in self.rows().zip(&self.rhs) {
             let scale = row.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             if scale == 0.0 {
@@ -106,8 +122,12 @@ impl Linear {
             }
             let b = rhs / scale;
             let key = row.iter().position(|v| v.abs() > KEY * scale).unwrap_or(k);
-            let same = out.rows().zip(&keys).position(|(r, kr)| {
-                *kr == key && r.iter().zip(row).all(|(x, y)| (x - y / scale).abs() <= 1e-12)
+            let same = keys.iter().enumerate().position(|(i, kr)| {
+                *kr == key
+                    && out.rows[i * k..(i + 1) * k]
+                        .iter()
+                        .zip(row)
+                        .all(|(x, y)| (x - y / scale).abs() <= 1e-12)
             });
             match same {
                 Some(i) => out.rhs[i] = out.rhs[i].min(b),
@@ -117,7 +137,6 @@ impl Linear {
                 }
             }
         }
-        out
     }
 
     /// Whether `x` meets every row (to `1e-9` of the row's scale).

@@ -46,13 +46,19 @@ pub(crate) struct Frame {
     /// `Σ f = total + sumsᵀ x`, N.
     pub(crate) total: f64,
     pub(crate) sums: Vec<f64>,
+    /// Scratch of [`Frame::fill`]: the box of `λ` (then `Nᵀ 1` in `lo`).
+    lo: Vec<f64>,
+    hi: Vec<f64>,
 }
 
-/// The closed-form box of `λ` over the tension limits: `(lo, hi)`.
-pub(crate) fn lambda_box(set: &EquilibriumSet) -> (Vec<f64>, Vec<f64>) {
+/// The closed-form box of `λ` over the tension limits into `(lo, hi)`.
+pub(crate) fn lambda_box(set: &EquilibriumSet, lo: &mut Vec<f64>, hi: &mut Vec<f64>) {
     let null = set.null_basis();
     let p = set.particular();
-    let (mut lo, mut hi) = (vec![0.0; set.dimension()], vec![0.0; set.dimension()]);
+    lo.clear();
+    lo.resize(set.dimension(), 0.0);
+    hi.clear();
+    hi.resize(set.dimension(), 0.0);
     for i in 0..set.dimension() {
         for c in 0..set.cable_count() {
             let a = null[(c, i)] * (set.lower()[c] - p[c]);
@@ -61,10 +67,51 @@ pub(crate) fn lambda_box(set: &EquilibriumSet) -> (Vec<f64>, Vec<f64>) {
             hi[i] += a.max(b);
         }
     }
-    (lo, hi)
+}
+
+/// The symmetric part of the pencil's matrix `a` (`a[(r, c)]` is entry `r` of column `c`),
+/// scaled by `scale`, over the rows and columns `span` where the matrix can be non-zero (a
+/// decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`), added into `out`, row-major, a
+/// square of side `side` whose first row and column are `origin`'s.
+fn add_symmetric(
+    a: &faer::Mat<f64>,
+    span: Range<usize>,
+    scale: f64,
+    out: &mut [f64],
+    side: usize,
+    origin: usize,
+) {
+    for c in span.clone() {
+        for (r, v) in a.col_as_slice(c)[span.clone()].iter().enumerate() {
+            let (r, c) = (r + span.start - origin, c - origin);
+            out[r * side + c] += 0.5 * scale * v;
+            out[c * side + r] += 0.5 * scale * v;
+        }
+    }
 }
 
 impl Frame {
+    /// A frame with no buffers yet ([`Frame::fill`] sizes them).
+    pub(crate) fn empty() -> Frame {
+        Frame {
+            n: 0,
+            free: Vec::new(),
+            base: Vec::new(),
+            width: Vec::new(),
+            a0: Vec::new(),
+            ai: Vec::new(),
+            spans: Vec::new(),
+            a_scale: 1.0,
+            j_x: Vec::new(),
+            rows: Vec::new(),
+            rhs: Vec::new(),
+            total: 0.0,
+            sums: Vec::new(),
+            lo: Vec::new(),
+            hi: Vec::new(),
+        }
+    }
+
     /// The frame of `pencil` on `set` with the rows `linear` (in `λ`) and the coordinates
     /// `held` fixed at their values.
     pub(crate) fn new(
@@ -73,11 +120,29 @@ impl Frame {
         linear: &Linear,
         held: &[(usize, f64)],
     ) -> Frame {
+        let mut frame = Frame::empty();
+        frame.fill(pencil, set, linear, held);
+        frame
+    }
+
+    /// [`Frame::new`] into this frame's buffers (a plan's frame is kept in its workspace:
+    /// re-planning along a trajectory allocates none of it again).
+    pub(crate) fn fill(
+        &mut self,
+        pencil: &Pencil,
+        set: &EquilibriumSet,
+        linear: &Linear,
+        held: &[(usize, f64)],
+    ) {
         let n = pencil.a0.nrows();
-        let (lo, hi) = lambda_box(set);
-        let mut base: Vec<f64> = lo.iter().zip(&hi).map(|(a, b)| 0.5 * (a + b)).collect();
-        let mut free = Vec::new();
-        let mut width = Vec::new();
+        self.n = n;
+        let (lo, hi) = (&mut self.lo, &mut self.hi);
+        lambda_box(set, lo, hi);
+        let base = &mut self.base;
+        base.clear();
+        base.extend(lo.iter().zip(hi.iter()).map(|(a, b)| 0.5 * (a + b)));
+        self.free.clear();
+        self.width.clear();
         for i in 0..set.dimension() {
             if let Some(&(_, v)) = held.iter().find(|(c, _)| *c == i) {
                 base[i] = v;
@@ -85,62 +150,44 @@ impl Frame {
             }
             let w = 0.5 * (hi[i] - lo[i]);
             if w > 1e-12 * (1.0 + base[i].abs()) {
-                free.push(i);
-                width.push(w);
+                self.free.push(i);
+                self.width.push(w);
             }
         }
-        // The symmetric parts, row-major, from the pencil's columns (`a[(r, c)]` is entry `r`
-        // of column `c`) over the rows and columns `span` where the matrix can be non-zero
-        // (a decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`), into `out`, a square
-        // of side `side` whose first row and column are `origin`'s.
-        let symmetric = |a: &faer::Mat<f64>,
-                         span: Range<usize>,
-                         scale: f64,
-                         out: &mut [f64],
-                         side: usize,
-                         origin: usize| {
-            for c in span.clone() {
-                for (r, v) in a.col_as_slice(c)[span.clone()].iter().enumerate() {
-                    let (r, c) = (r + span.start - origin, c - origin);
-                    out[r * side + c] += 0.5 * scale * v;
-                    out[c * side + r] += 0.5 * scale * v;
-                }
-            }
-        };
         let span = |i: usize| pencil.spans.get(i).cloned().unwrap_or(0..n);
-        let mut a0 = vec![0.0; n * n];
-        symmetric(&pencil.a0, 0..n, 1.0, &mut a0, n, 0);
+        self.a0.clear();
+        self.a0.resize(n * n, 0.0);
+        add_symmetric(&pencil.a0, 0..n, 1.0, &mut self.a0, n, 0);
         for (i, (l, a)) in base.iter().zip(&pencil.ai).enumerate() {
             if *l != 0.0 {
-                symmetric(a, span(i), *l, &mut a0, n, 0);
+                add_symmetric(a, span(i), *l, &mut self.a0, n, 0);
             }
         }
-        let spans: Vec<Range<usize>> = free.iter().map(|&i| span(i)).collect();
-        let ai: Vec<Vec<f64>> = free
-            .iter()
-            .zip(&width)
-            .zip(&spans)
-            .map(|((&i, w), span)| {
-                let side = span.len();
-                let mut out = vec![0.0; side * side];
-                symmetric(&pencil.ai[i], span.clone(), *w, &mut out, side, span.start);
-                out
-            })
-            .collect();
-        let a_scale = (0..n).map(|i| a0[i * n + i].abs()).fold(0.0, f64::max).max(1e-12);
-        let mut j_x = vec![0.0; 6 * n];
+        self.spans.clear();
+        self.spans.extend(self.free.iter().map(|&i| span(i)));
+        self.ai.truncate(self.free.len());
+        self.ai.resize_with(self.free.len(), Vec::new);
+        for (((&i, w), span), out) in
+            self.free.iter().zip(&self.width).zip(&self.spans).zip(&mut self.ai)
+        {
+            let side = span.len();
+            out.clear();
+            out.resize(side * side, 0.0);
+            add_symmetric(&pencil.ai[i], span.clone(), *w, out, side, span.start);
+        }
+        self.a_scale = (0..n).map(|i| self.a0[i * n + i].abs()).fold(0.0, f64::max).max(1e-12);
+        self.j_x.clear();
         for r in 0..6 {
-            for c in 0..n {
-                j_x[r * n + c] = pencil.j_x[(r, c)];
-            }
+            self.j_x.extend((0..n).map(|c| pencil.j_x[(r, c)]));
         }
-        let k = free.len();
-        let (mut rows, mut rhs) =
-            (Vec::with_capacity(linear.rhs.len() * k), Vec::with_capacity(linear.rhs.len()));
+        let k = self.free.len();
+        let (rows, rhs) = (&mut self.rows, &mut self.rhs);
+        rows.clear();
+        rhs.clear();
         for (row, h) in linear.rows().zip(&linear.rhs) {
-            let shift: f64 = row.iter().zip(&base).map(|(a, b)| a * b).sum();
+            let shift: f64 = row.iter().zip(base.iter()).map(|(a, b)| a * b).sum();
             let start = rows.len();
-            rows.extend(free.iter().zip(&width).map(|(&i, w)| row[i] * w));
+            rows.extend(self.free.iter().zip(&self.width).map(|(&i, w)| row[i] * w));
             let g = &mut rows[start..];
             let scale = g.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             if scale <= 1e-14 * row.iter().fold(0.0_f64, |a, v| a.max(v.abs())).max(1e-300) {
@@ -151,12 +198,15 @@ impl Frame {
             g.iter_mut().for_each(|v| *v /= scale);
             rhs.push((h - shift) / scale);
         }
-        let column_sums = crate::rows::column_sums(set);
-        let total = set.particular().iter().sum::<f64>()
-            + column_sums.iter().zip(&base).map(|(a, b)| a * b).sum::<f64>();
-        let sums = free.iter().zip(&width).map(|(&i, w)| column_sums[i] * w).collect();
-        debug_assert_eq!(rows.len(), rhs.len() * k);
-        Frame { n, free, base, width, a0, ai, spans, a_scale, j_x, rows, rhs, total, sums }
+        // Σ f = Σ f_p + (Nᵀ1)ᵀ λ (`Nᵀ1` into `lo`, no longer needed).
+        let column_sums = &mut self.lo;
+        column_sums.clear();
+        column_sums.extend(crate::rows::column_sums(set));
+        self.total = set.particular().iter().sum::<f64>()
+            + column_sums.iter().zip(base.iter()).map(|(a, b)| a * b).sum::<f64>();
+        self.sums.clear();
+        self.sums.extend(self.free.iter().zip(&self.width).map(|(&i, w)| column_sums[i] * w));
+        debug_assert_eq!(self.rows.len(), self.rhs.len() * k);
     }
 
     /// Free coordinates.
@@ -173,9 +223,16 @@ impl Frame {
         l
     }
 
-    /// `x` of `λ` (the held coordinates ignored).
-    pub(crate) fn x_of(&self, lambda: &[f64]) -> Vec<f64> {
-        self.free.iter().zip(&self.width).map(|(&i, w)| (lambda[i] - self.base[i]) / w).collect()
+    /// `x` of the tensions `f` (the held coordinates ignored) into `out`: `λ = Nᵀ(f − f_p)`
+    /// ([`EquilibriumSet::coordinates`]), then `x_a = (λ_i − λ_c,i) / w_i`.
+    pub(crate) fn x_of_tensions(&self, set: &EquilibriumSet, f: &[f64], out: &mut Vec<f64>) {
+        let (null, p) = (set.null_basis(), set.particular());
+        let m = set.cable_count().min(f.len());
+        out.clear();
+        out.extend(self.free.iter().zip(&self.width).map(|(&i, w)| {
+            let lambda: f64 = (0..m).map(|c| null[(c, i)] * (f[c] - p[c])).sum();
+            (lambda - self.base[i]) / w
+        }));
     }
 
     /// `A(x)` into `out` (n × n).

@@ -30,19 +30,25 @@ pub(crate) fn cold(
 }
 
 /// Newton steps on the mapped previous answer's active set ([`active::warm`]); where they do
-/// not apply or are not certified, the last phase from the mapped previous answer `x`
-/// (restored into the interior when it is not strictly inside), capped at [`WARM_ITERATIONS`]: the answer, or the iterations spent
-/// when it is refused (not restorable, not certified in time).
+/// not apply or are not certified, the last phase from the mapped previous answer (restored
+/// into the interior when it is not strictly inside), capped at [`WARM_ITERATIONS`]: the
+/// answer, or the iterations spent when it is refused (not restorable, not certified in time).
+/// The mapped answer is `work.mapped`; the Newton steps' buffers are `work`'s.
 pub(crate) fn warm(
     frame: &Frame,
     objective: Objective,
     requirements: &Requirements,
     settings: &PlanSettings,
-    x: Vec<f64>,
     previous_active: Option<&[usize]>,
+    work: &mut active::WarmWork,
 ) -> Result<Answer, usize> {
-    let tried = match active::warm(frame, objective, requirements, settings, &x, previous_active) {
-        Ok(answer) => return Ok(answer),
+    let x = std::mem::take(&mut work.mapped);
+    let newton = active::warm(frame, objective, requirements, settings, &x, previous_active, work);
+    let tried = match newton {
+        Ok(answer) => {
+            work.mapped = x;
+            return Ok(answer);
+        }
         Err(steps) => steps,
     };
     let mut problem = Interior::new(frame, objective, requirements, settings);

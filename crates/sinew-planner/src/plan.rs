@@ -19,7 +19,7 @@ use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
 use crate::rows::{
-    HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows, rate_error, rate_rows,
+    HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows_into, rate_error, rate_rows,
 };
 
 /// The planner's model: the arm (robot, routing, statics). Immutable; one [`PlannerData`] per
@@ -44,6 +44,12 @@ pub struct PlannerData {
     pub(crate) margin: (Vec<f64>, LeastEigen),
     /// The last plan's equilibrium set: the next pose's is copied into its buffers.
     set: Option<EquilibriumSet>,
+    /// The last interior-point plan's frame, its buffers reused by the next.
+    frame: Option<Frame>,
+    /// The last plan's rows in `λ`, merged, and the merge's scratch.
+    rows: Option<(Linear, Linear, Vec<usize>)>,
+    /// The warm step's buffers.
+    warm: active::WarmWork,
 }
 
 impl PlannerData {
@@ -56,6 +62,9 @@ impl PlannerData {
             pencil: None,
             margin: (Vec::new(), LeastEigen::default()),
             set: None,
+            frame: None,
+            rows: None,
+            warm: active::WarmWork::default(),
         }
     }
 
@@ -168,8 +177,10 @@ impl Planner {
         };
         let mut pencil = data.pencil.take().unwrap_or_else(Pencil::empty);
         pencil.fill(arm, sd, &set)?;
-        let mut linear =
-            linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
+        let (mut linear, mut merged, mut keys) =
+            data.rows.take().unwrap_or_else(|| (Linear::new(0, 0), Linear::new(0, 0), Vec::new()));
+        let budgets = self.joint_budget_rows(requirements);
+        linear_rows_into(&set, requirements.budget, &budgets, &mut linear);
         let previous = data.previous.take();
         if let (Some(change), Some(previous)) = (rate, &previous) {
             rate_rows(&set, previous, change, &mut linear);
@@ -178,13 +189,16 @@ impl Planner {
         let (lambda, upper, iterations) = match settings.method {
             Method::InteriorPoint => {
                 let held = held_coordinates(&set, &fixed);
-                let frame = Frame::new(&pencil, &set, &linear.merged(), &held);
+                linear.merged_into(&mut merged, &mut keys);
+                let mut frame = data.frame.take().unwrap_or_else(Frame::empty);
+                frame.fill(&pencil, &set, &merged, &held);
                 let rows = frame.rhs.len();
-                let active = data.active.take();
-                let active = active.as_ref().filter(|(n, _)| *n == rows).map(|(_, a)| &a[..]);
+                let taken = data.active.take();
+                let active = taken.as_ref().filter(|(n, _)| *n == rows).map(|(_, a)| &a[..]);
+                let mut work = std::mem::take(&mut data.warm);
                 let attempt = previous.as_ref().map(|f| {
-                    let x = frame.x_of(&set.coordinates(f));
-                    interior::warm(&frame, objective, requirements, settings, x, active)
+                    frame.x_of_tensions(&set, f, &mut work.mapped);
+                    interior::warm(&frame, objective, requirements, settings, active, &mut work)
                 });
                 let limited = rate.is_some() && previous.is_some();
                 let cold = |data: &mut PlannerData| {
@@ -206,8 +220,15 @@ impl Planner {
                     }
                     None => cold(data)?,
                 };
-                data.active = Some((rows, active::active_rows(&frame, &answer.x)));
-                (frame.lambda(&answer.x), answer.upper, before + answer.iterations)
+                let mut kept = taken.map(|(_, a)| a).unwrap_or_default();
+                active::active_rows_into(&frame, &answer.x, &mut kept, work.pairs());
+                data.active = Some((rows, kept));
+                let lambda = frame.lambda(&answer.x);
+                // The buffers back into the workspace, the answer's `x` as the next iterate's.
+                work.x = answer.x;
+                data.warm = work;
+                data.frame = Some(frame);
+                (lambda, answer.upper, before + answer.iterations)
             }
             Method::Bundle => {
                 fix_rows(&set, &fixed, &mut linear);
@@ -226,7 +247,8 @@ impl Planner {
             }
         };
         data.pencil = Some(pencil);
-        let plan = self.answer(data, &set, objective, requirements, &lambda, upper, iterations)?;
+        data.rows = Some((linear, merged, keys));
+        let plan = self.answer(data, &set, objective, requirements, lambda, upper, iterations)?;
         // The tensions into the last ones' buffer.
         let mut kept = previous.unwrap_or_default();
         kept.clone_from(&plan.tensions);
@@ -274,7 +296,7 @@ impl Planner {
             linear,
             // Σ f = Σ f_p + (Nᵀ 1)ᵀ λ: its constant and gradient, once per plan.
             total: set.particular().iter().sum(),
-            sums: column_sums(set),
+            sums: column_sums(set).collect(),
             // K_des was checked symmetric positive definite.
             k_des_scale: requirements.k_des.and_then(|k| k.cholesky()).map(|c| c.l()),
             scale: pencil_scale(pencil),
@@ -295,13 +317,13 @@ impl Planner {
         set: &EquilibriumSet,
         objective: Objective,
         requirements: &Requirements,
-        lambda: &[f64],
+        lambda: Vec<f64>,
         upper: f64,
         iterations: usize,
     ) -> Result<Plan, PlanError> {
         let arm = &self.arm;
         let mut tensions = vec![0.0; set.cable_count()];
-        set.tensions(lambda, &mut tensions)?;
+        set.tensions(&lambda, &mut tensions)?;
         for (f, (lo, hi)) in tensions.iter_mut().zip(set.lower().iter().zip(set.upper())) {
             *f = f.clamp(*lo, *hi);
         }

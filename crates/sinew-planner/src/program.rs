@@ -61,7 +61,7 @@ impl Block {
 }
 
 /// The problem: maximise `c₀ + cᵀx + ψ(x)` over rows and blocks; `[lo, hi]` bounds an optimum.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Sdp {
     pub(crate) c0: f64,
     pub(crate) c: Vec<f64>,

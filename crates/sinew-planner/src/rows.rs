@@ -7,9 +7,9 @@ use crate::bundle::Linear;
 use crate::error::PlanError;
 
 /// `Nᵀ 1`: how the total tension changes per unit of each `λ`.
-pub(crate) fn column_sums(set: &EquilibriumSet) -> Vec<f64> {
+pub(crate) fn column_sums(set: &EquilibriumSet) -> impl Iterator<Item = f64> + '_ {
     let null = set.null_basis();
-    (0..set.dimension()).map(|i| (0..set.cable_count()).map(|c| null[(c, i)]).sum()).collect()
+    (0..set.dimension()).map(move |i| (0..set.cable_count()).map(|c| null[(c, i)]).sum())
 }
 
 /// The limits `f_min ≤ f_p + N λ ≤ f_max`, the budget `Σ f ≤ B` and the per-joint budgets
@@ -19,11 +19,23 @@ pub(crate) fn linear_rows(
     budget: Option<f64>,
     joint_budgets: &[(std::ops::Range<usize>, f64)],
 ) -> Linear {
+    let mut linear = Linear::new(0, 0);
+    linear_rows_into(set, budget, joint_budgets, &mut linear);
+    linear
+}
+
+/// [`linear_rows`] into `linear`'s buffers (its rows replaced).
+pub(crate) fn linear_rows_into(
+    set: &EquilibriumSet,
+    budget: Option<f64>,
+    joint_budgets: &[(std::ops::Range<usize>, f64)],
+    linear: &mut Linear,
+) {
     let null = set.null_basis();
     let (m, k) = (set.cable_count(), set.dimension());
     let p = set.particular();
     // Room for the limits, the budgets and the rate rows a trajectory adds.
-    let mut linear = Linear::new(k, 4 * m + 1 + joint_budgets.len());
+    linear.clear(k, 4 * m + 1 + joint_budgets.len());
     for c in 0..m {
         linear.push((0..k).map(|i| null[(c, i)]), set.upper()[c] - p[c]);
         linear.push((0..k).map(|i| -null[(c, i)]), p[c] - set.lower()[c]);
@@ -35,7 +47,6 @@ pub(crate) fn linear_rows(
         let row = (0..k).map(|i| cables.clone().map(|c| null[(c, i)]).sum());
         linear.push(row, b - cables.clone().map(|c| p[c]).sum::<f64>());
     }
-    linear
 }
 
 /// A joint held at a level: its cables and their tensions there.

@@ -58,6 +58,20 @@ pub(crate) struct EndObjective<'a> {
     g: Vec<f64>,
 }
 
+/// The buffers of an [`EndObjective`] (its fields of the same names), kept between objectives.
+#[derive(Debug, Default)]
+pub(crate) struct EndBuffers {
+    a: Vec<f64>,
+    yt: Vec<f64>,
+    supports: Vec<std::ops::Range<usize>>,
+    zs: Vec<f64>,
+    az: Vec<f64>,
+    la: Vec<f64>,
+    ta: Vec<f64>,
+    kta: Vec<f64>,
+    g: Vec<f64>,
+}
+
 /// `K_x` at `x` (the factor of `A` and `Y = A⁻¹ J_xᵀ` stay in the objective's buffers).
 pub(crate) struct EndAt {
     pub(crate) k_x: Matrix6<f64>,
@@ -65,11 +79,7 @@ pub(crate) struct EndAt {
 
 impl<'a> EndObjective<'a> {
     pub(crate) fn new(frame: &'a Frame, kind: Kind, scale: f64) -> EndObjective<'a> {
-        let columns = match kind {
-            Kind::Along(_) => 1,
-            Kind::Volume => 3,
-        };
-        Self::with_columns(frame, kind, scale, columns)
+        Self::reusing(frame, kind, scale, EndBuffers::default())
     }
 
     /// Buffers for [`Self::end_at`] only (`K_x` at a point, no derivatives).
@@ -79,21 +89,59 @@ impl<'a> EndObjective<'a> {
 
     /// The buffers of the derivatives sized for `c` vectors `z_j`.
     fn with_columns(frame: &'a Frame, kind: Kind, scale: f64, c: usize) -> EndObjective<'a> {
+        Self::in_buffers(frame, kind, scale, c, EndBuffers::default())
+    }
+
+    /// [`EndObjective::new`] in the buffers of an earlier objective ([`Self::into_buffers`]):
+    /// no allocation once they have the room.
+    pub(crate) fn reusing(
+        frame: &'a Frame,
+        kind: Kind,
+        scale: f64,
+        buffers: EndBuffers,
+    ) -> EndObjective<'a> {
+        let columns = match kind {
+            Kind::Along(_) => 1,
+            Kind::Volume => 3,
+        };
+        Self::in_buffers(frame, kind, scale, columns, buffers)
+    }
+
+    /// The buffers, for a later objective ([`Self::reusing`]).
+    pub(crate) fn into_buffers(self) -> EndBuffers {
+        let EndObjective { a, yt, supports, zs, az, la, ta, kta, g, .. } = self;
+        EndBuffers { a, yt, supports, zs, az, la, ta, kta, g }
+    }
+
+    fn in_buffers(
+        frame: &'a Frame,
+        kind: Kind,
+        scale: f64,
+        c: usize,
+        b: EndBuffers,
+    ) -> EndObjective<'a> {
         let (n, k) = (frame.n, frame.vars());
         let k = if c == 0 { 0 } else { k };
+        let sized = |mut v: Vec<f64>, len: usize| {
+            v.clear();
+            v.resize(len, 0.0);
+            v
+        };
+        let mut supports = b.supports;
+        supports.clone_from(&frame.spans);
         EndObjective {
             frame,
             kind,
             scale,
-            a: vec![0.0; n * n],
-            yt: vec![0.0; 6 * n],
-            supports: frame.spans.clone(),
-            zs: vec![0.0; c * n],
-            az: vec![0.0; k * c * n],
-            la: vec![0.0; k * c * n],
-            ta: vec![0.0; k * c * 6],
-            kta: vec![0.0; k * c * 6],
-            g: vec![0.0; k * c * c],
+            a: sized(b.a, n * n),
+            yt: sized(b.yt, 6 * n),
+            supports,
+            zs: sized(b.zs, c * n),
+            az: sized(b.az, k * c * n),
+            la: sized(b.la, k * c * n),
+            ta: sized(b.ta, k * c * 6),
+            kta: sized(b.kta, k * c * 6),
+            g: sized(b.g, k * c * c),
         }
     }
 

@@ -142,14 +142,7 @@ impl Planner {
             History::Pull | History::Release => None,
         };
         let at = Evaluated { c_x, k_fd, min_eigenvalue };
-        plan_at(
-            objective,
-            (&lambda, tensions),
-            at,
-            answer.upper,
-            before + answer.iterations,
-            levels,
-        )
+        plan_at(objective, (lambda, tensions), at, answer.upper, before + answer.iterations, levels)
     }
 }
 

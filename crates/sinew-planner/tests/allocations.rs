@@ -4,8 +4,9 @@
 //! mean the iterations past the second allocated nothing. A method that allocated a scratch
 //! vector per iteration, or per step-length trial, gives counts that grow with the cap.
 //!
-//! The set-up of a plan still allocates (the equilibrium set, the pencil, the frame, the
-//! blocks of each phase, the plan's own vectors): counted here, not claimed to be zero.
+//! The set-up of a cold plan still allocates (the blocks of each phase, the programs' vectors,
+//! the plan's own vectors): counted here, not claimed to be zero. A warm step along a
+//! trajectory allocates only the plan it returns (the last test).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Vector3, Vector6};
@@ -19,8 +20,12 @@ use sinew_testkit::cdhrm5;
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
 
+/// The counter is global: the tests of this binary run one at a time.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn iterations_of_the_interior_point_method_allocate_nothing() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     assert_counting();
     let objectives = [
         Objective::StiffnessAlong(Vector3::y()),
@@ -91,4 +96,77 @@ fn iterations_of_the_interior_point_method_allocate_nothing() {
             );
         }
     }
+}
+
+/// A warm step along a trajectory allocates only its plan's own vectors (`λ`, the tensions,
+/// and the levels where the arm has the closed form: allocated then, and kept when every
+/// joint's interval holds the plan's tensions), for the objectives whose warm step is Newton's
+/// on the active set (module docs of `along.rs`). The allocations of step `j` are those of a
+/// run over the first `j + 1` steps less those of a run over the first `j` (the runs are the
+/// same up to there: each starts cold from its first step), the least of three counts each.
+/// Before the warm step had its workspace (41ca3ab), decoupled stiffness-along: 124 a step.
+#[test]
+fn a_warm_step_allocates_only_its_plan() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    assert_counting();
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let steps: Vec<sinew_planner::Step> = cdhrm5::swaying_poses(12, 1e-3, 0.0)
+        .into_iter()
+        .map(|q| sinew_planner::Step { q, f0 })
+        .collect();
+    let requirements = Requirements::default();
+    let settings = PlanSettings::default();
+    let mut warm_steps = 0;
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        let mut data = PlannerData::new(&planner);
+        let own = 2 + usize::from(planner.arm().statics().has_levels());
+        for objective in
+            [Objective::StiffnessAlong(Vector3::y()), Objective::Volume, Objective::LeastTension]
+        {
+            let mut run = |n: usize| {
+                let mut least = usize::MAX;
+                let mut along = Vec::new();
+                for _ in 0..3 {
+                    let (allocations, result) = count(|| {
+                        planner.plan_along(
+                            &mut data,
+                            &steps[..n],
+                            objective,
+                            &requirements,
+                            &settings,
+                            None,
+                        )
+                    });
+                    least = least.min(allocations);
+                    along = result.unwrap();
+                }
+                (least, along)
+            };
+            // Once before counting: the first run sizes the workspace's buffers.
+            run(steps.len());
+            let mut counts = Vec::new();
+            let (mut before, _) = run(1);
+            for n in 2..=steps.len() {
+                let (now, along) = run(n);
+                let last = along.last().unwrap();
+                assert!(last.plan.is_ok(), "{model:?} {}: step {n}", objective.name());
+                if last.warm {
+                    warm_steps += 1;
+                    counts.push(now - before);
+                }
+                before = now;
+            }
+            println!("{model:?} {}: allocations of the warm steps: {counts:?}", objective.name());
+            assert!(
+                counts.iter().all(|c| *c == own),
+                "{model:?} {}: a warm step allocates more than its plan's {own} vectors: {counts:?}",
+                objective.name()
+            );
+        }
+    }
+    // Decoupled least tension runs cold at this load (its margin is active); the other five
+    // take every step warm.
+    assert!(warm_steps >= 5 * 11, "{warm_steps} warm steps of 66");
 }

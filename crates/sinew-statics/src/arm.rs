@@ -427,19 +427,21 @@ pub fn check_balance(
             }));
         }
     }
-    let residual: Vec<f64> = (0..t0.len())
-        .map(|d| t0[d] + (0..m).map(|c| jacobian[(c, d)] * tensions[c]).sum::<f64>())
-        .collect();
-    let scale = norm(t0).max(
-        (0..t0.len())
-            .map(|d| (0..m).map(|c| (jacobian[(c, d)] * tensions[c]).abs()).sum::<f64>())
-            .fold(0.0, f64::max),
-    );
-    if norm(&residual) > EQUILIBRIUM_TOLERANCE * scale {
-        return Err(StaticsError::NotBalanced(NotBalanced::Residual {
-            residual: norm(&residual),
-            t0: norm(t0),
-        }));
+    // |T0 + Jᵀ f| and the largest Σ_c |J_cd f_c|, one DOF at a time (no allocation: a
+    // planner's answer is checked by this at every step).
+    let (mut squares, mut largest) = (0.0_f64, 0.0_f64);
+    for (d, t) in t0.iter().enumerate() {
+        let (mut r, mut size) = (*t, 0.0);
+        for (c, f) in tensions.iter().enumerate() {
+            r += jacobian[(c, d)] * f;
+            size += (jacobian[(c, d)] * f).abs();
+        }
+        squares += r * r;
+        largest = largest.max(size);
+    }
+    let residual = squares.sqrt();
+    if residual > EQUILIBRIUM_TOLERANCE * norm(t0).max(largest) {
+        return Err(StaticsError::NotBalanced(NotBalanced::Residual { residual, t0: norm(t0) }));
     }
     Ok(())
 }
