@@ -83,7 +83,8 @@ pub fn base_directions() -> [Vector6<f64>; 12] {
 /// ([`crate::stick_stiffness`], dof × dof), `k_w` the load's (`K_W`), `j_x` the end-effector
 /// Jacobian (6 × dof), `friction` the friction geometry at the pose (with the history's
 /// capstan weights for [`History::Pull`] and [`History::Release`]). One factorisation of
-/// `K_stick + K_W`, then one solve per direction (module docs for the math).
+/// `K_stick + K_W`, one solve with a right-hand side per direction, and one pass over the
+/// holes for every direction (module docs for the math).
 ///
 /// # Errors
 /// [`StiffnessError::StickWithoutFriction`] for a cable with μ = 0;
@@ -125,26 +126,40 @@ pub fn stick_load_limits(
         return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_stick, k_w)? });
     }
     let lu = k.partial_piv_lu();
-    let mut out = Vec::with_capacity(directions.len());
-    for u in directions {
-        let rhs = Mat::from_fn(n, 1, |i, _| (0..6).map(|r| j_x[(r, i)] * u[r]).sum::<f64>());
-        let dq = lu.solve(rhs);
-        let dq: Vec<f64> = (0..n).map(|i| dq[(i, 0)]).collect();
-        out.push(along(model, friction, &holes, u, dq)?);
-    }
-    Ok(out)
+    // Every direction's joint motion in one solve with as many right-hand sides, then one pass
+    // over the holes for them all.
+    let rhs = Mat::from_fn(n, directions.len(), |i, j| {
+        (0..6).map(|r| j_x[(r, i)] * directions[j][r]).sum::<f64>()
+    });
+    let dq = lu.solve(rhs);
+    along(model, friction, &holes, directions, dq.as_ref())
 }
 
-/// The limit along `u`, given its joint motion `dq` per unit `α`.
+/// The limit along each of `directions`, given their joint motions per unit `α` (the columns
+/// of `dq`, n × directions): one pass over the holes for every direction, each hole's
+/// coefficients read once and each segment's stretch `J_s δQ` computed once per direction (it
+/// is the stretch after one hole and before the next).
 fn along(
     model: &FrictionModel,
     friction: &FrictionData,
     holes: &[Hole],
-    u: &Vector6<f64>,
-    dq: Vec<f64>,
-) -> Result<StickLoadLimit, StiffnessError> {
-    let mut best = (f64::INFINITY, None);
-    let mut at_once = Vec::new();
+    directions: &[Vector6<f64>],
+    dq: MatRef<'_, f64>,
+) -> Result<Vec<StickLoadLimit>, StiffnessError> {
+    let n = dq.nrows();
+    let mut out: Vec<StickLoadLimit> = directions
+        .iter()
+        .enumerate()
+        .map(|(j, u)| StickLoadLimit {
+            direction: *u,
+            magnitude: f64::INFINITY,
+            first: None,
+            at_once: Vec::new(),
+            joint_motion: (0..n).map(|i| dq[(i, j)]).collect(),
+        })
+        .collect();
+    // Each direction's stretch of the segment before the current hole.
+    let mut stretch = vec![0.0; directions.len()];
     // The holes come cable by cable, hole by hole ([`holes`]): walk each cable's segments
     // (read once per cable) in step, segment `k` before hole `k` and `k + 1` after it.
     let mut pending = holes.iter();
@@ -153,6 +168,8 @@ fn along(
         let Some((_, mut before)) = segments.next() else {
             continue;
         };
+        // The free length does not stretch (the actuator holds its end).
+        stretch.fill(0.0);
         for (s, after) in segments {
             let h = match pending.next() {
                 Some(h) if (h.cable, h.hole + 1) == (c, s) => h,
@@ -162,33 +179,38 @@ fn along(
                     return Err(StiffnessError::DimensionMismatch { what, expected, got: s });
                 }
             };
-            // δT per unit α of the two segments: spring times stretch (the free length's is 0).
-            let rate = |segment: &sinew_routing::SegmentRows<'_>, k: usize, spring: f64| {
-                if k == 0 { 0.0 } else { spring * dot(&segment.jacobian, &dq) }
-            };
-            let dt_k = rate(&before, s - 1, h.springs[0]);
-            let dt_next = rate(&after, s, h.springs[1]);
-            let dtheta = dot(&before.wrap_gradient, &dq);
-            for edge in [BandEdge::Lower, BandEdge::Upper] {
-                let (a, b, d) = h.rate_coefficients(edge);
-                let dg = a * dt_next + b * dt_k + d * dtheta;
-                let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
-                if dg >= -RATE_TOLERANCE * terms {
-                    continue;
-                }
+            let edges = [BandEdge::Lower, BandEdge::Upper].map(|edge| {
                 let g = h.room(edge);
-                if g <= EDGE_TOLERANCE * h.scale() {
-                    at_once.push(h.event(edge));
-                } else if g / -dg < best.0 {
-                    best = (g / -dg, Some(h.event(edge)));
+                (edge, h.rate_coefficients(edge), g, g <= EDGE_TOLERANCE * h.scale())
+            });
+            for (limit, stretch) in out.iter_mut().zip(stretch.iter_mut()) {
+                let dq = &limit.joint_motion;
+                // δT per unit α of the two segments: spring times stretch.
+                let dt_k = h.springs[0] * *stretch;
+                *stretch = dot(&after.jacobian, dq);
+                let dt_next = h.springs[1] * *stretch;
+                let dtheta = dot(&before.wrap_gradient, dq);
+                for &(edge, (a, b, d), g, at_edge) in &edges {
+                    let dg = a * dt_next + b * dt_k + d * dtheta;
+                    let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
+                    if dg >= -RATE_TOLERANCE * terms {
+                        continue;
+                    }
+                    if at_edge {
+                        limit.at_once.push(h.event(edge));
+                    } else if g / -dg < limit.magnitude {
+                        limit.magnitude = g / -dg;
+                        limit.first = Some(h.event(edge));
+                    }
                 }
             }
             before = after;
         }
     }
-    let (magnitude, first) = match at_once.first() {
-        Some(&event) => (0.0, Some(event)),
-        None => best,
-    };
-    Ok(StickLoadLimit { direction: *u, magnitude, first, at_once, joint_motion: dq })
+    for limit in &mut out {
+        if let Some(&event) = limit.at_once.first() {
+            (limit.magnitude, limit.first) = (0.0, Some(event));
+        }
+    }
+    Ok(out)
 }
