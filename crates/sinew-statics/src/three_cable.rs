@@ -206,7 +206,9 @@ pub(crate) fn triangular(
         s.rhs.fill(0.0);
         s.rhs[d] = 1.0;
         s.column.fill(0.0);
-        solve(&s.rhs, joints, joints - 1, &mut s.column);
+        // A unit torque at joint d / 2 leaves the cables of the joints beyond it at zero: the
+        // back-substitution starts at its own joint.
+        solve(&s.rhs, d / 2 + 1, d / 2, &mut s.column);
         project(&mut s.column);
         for (c, v) in s.column.iter().enumerate() {
             block.pseudo_inverse[(d, c)] = *v;
