@@ -385,3 +385,60 @@ fn multipliers(
     }
     y.truncate(rows);
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use nalgebra::{DMatrix, DVector};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::lu_solve;
+
+    /// The KKT solve against nalgebra's LU: random systems of the warm step's shape
+    /// `[[−H + εI, Gᵀ], [G, 0]]` (a zero block on the diagonal, so that the elimination must
+    /// pivot), with `ε` as small as the least-tension step's; a singular system is refused.
+    #[test]
+    fn the_kkt_solve_is_the_lu_of_nalgebra() {
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        let mut worst: f64 = 0.0;
+        for case in 0..200 {
+            let k = 1 + case % 6;
+            let p = case % (k + 1);
+            let size = k + p;
+            let epsilon = [1e-12, 1e-3, 1.0][case % 3];
+            let mut a = DMatrix::<f64>::zeros(size, size);
+            let h = DMatrix::from_fn(k, k, |_, _| rng.random_range(-1.0..1.0));
+            let h = &h * h.transpose();
+            for i in 0..k {
+                for j in 0..k {
+                    a[(i, j)] = h[(i, j)] * if epsilon < 1e-6 { 0.0 } else { 1.0 };
+                }
+                a[(i, i)] += epsilon;
+            }
+            for r in 0..p {
+                for c in 0..k {
+                    let v = rng.random_range(-1.0..1.0);
+                    a[(k + r, c)] = v;
+                    a[(c, k + r)] = v;
+                }
+            }
+            let b = DVector::from_fn(size, |_, _| rng.random_range(-1.0..1.0));
+            let reference = a.clone().lu().solve(&b).unwrap();
+            let mut rows: Vec<f64> = a.transpose().iter().copied().collect();
+            let mut x: Vec<f64> = b.iter().copied().collect();
+            assert!(lu_solve(&mut rows, size, &mut x), "case {case}");
+            let scale = reference.amax().max(1.0);
+            let residual = (&a * DVector::from_column_slice(&x) - &b).amax();
+            for (got, want) in x.iter().zip(reference.iter()) {
+                worst = worst.max((got - want).abs() / scale);
+            }
+            assert!(residual <= 1e-9 * scale, "case {case}: residual {residual:e}");
+        }
+        assert!(worst <= 1e-6, "worst difference from nalgebra's LU {worst:e}");
+        // Singular: two equal rows; and a zero matrix.
+        let mut singular = vec![1.0, 2.0, 1.0, 2.0];
+        assert!(!lu_solve(&mut singular, 2, &mut [1.0, 1.0]));
+        assert!(!lu_solve(&mut [0.0; 9], 3, &mut [1.0; 3]));
+    }
+}
