@@ -14,7 +14,7 @@
 //! not symmetric; its end stiffness is not concave in the tensions, so it is not planned.
 //!
 //! The stick stiffness is the tangent while every hole stays inside its band: for load
-//! increments below the stick load limit ([`sinew_stiffness::stick_load_limit`]).
+//! increments below the stick load limit ([`sinew_stiffness::stick_load_limits`]).
 
 use nalgebra::{Matrix6, Vector6};
 use sinew_routing::{
