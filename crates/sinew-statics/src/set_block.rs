@@ -22,7 +22,7 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 
 use crate::error::StaticsError;
-use crate::three_cable::{Triangular, three_cable_joint, triangular};
+use crate::three_cable::{Share, Triangular, three_cable_joint, triangular};
 
 /// A singular value of `J_c` below this fraction of the largest counts as zero.
 pub const SET_RANK_TOLERANCE: f64 = 1e-10;
@@ -128,8 +128,8 @@ impl Block {
         }
         scratch.t.clear();
         scratch.t.extend(self.dofs.iter().map(|&d| t0[d]));
-        if three_cable_joint(self, &scratch.t)
-            || triangular(self, groups, &scratch.t, &mut scratch.triangular)
+        if self.closed_joint(&scratch.t)
+            || self.closed_chain(groups, &scratch.t, &mut scratch.triangular)
         {
             return Ok(());
         }
@@ -137,6 +137,28 @@ impl Block {
         let svd = self.by_svd(&t);
         scratch.t = t;
         svd
+    }
+
+    /// [`three_cable_joint`] on this block's `range` into its share.
+    fn closed_joint(&mut self, t: &[f64]) -> bool {
+        let (j, _, out) = self.parts();
+        three_cable_joint(j, t, out)
+    }
+
+    /// [`triangular`] on this block's `range` into its share.
+    fn closed_chain(&mut self, groups: &[Range<usize>], t: &[f64], s: &mut Triangular) -> bool {
+        let (j, dofs, out) = self.parts();
+        triangular((j, dofs), groups, t, s, out)
+    }
+
+    /// The block's submatrix of `J_c`, its DOFs, and its share to write.
+    fn parts(&mut self) -> (MatRef<'_, f64>, &[usize], Share<'_>) {
+        let share = Share {
+            particular: &mut self.particular,
+            null: &mut self.null,
+            pseudo_inverse: &mut self.pseudo_inverse,
+        };
+        (self.range.as_ref(), &self.dofs, share)
     }
 
     /// The block by the SVD of its submatrix of `J_c` (in `range` on entry; module docs), `t`
@@ -189,7 +211,7 @@ mod tests {
         for (a, e, delta) in cases {
             let j = block(a, e, delta);
             let mut closed = block_of(&j, vec![0, 1]);
-            assert!(three_cable_joint(&mut closed, &t), "closed form");
+            assert!(closed.closed_joint(&t), "closed form");
             let (fp, pinv) = (&closed.particular, &closed.pseudo_inverse);
             let n: Vec<f64> = (0..3).map(|c| closed.null[(c, 0)]).collect();
             let mut svd = block_of(&j, vec![0, 1]);
@@ -240,7 +262,7 @@ mod tests {
         // b = a + δ e with e ⊥ a, |a| = |e| = 1: σ₂/σ₁ ≈ δ/2.
         let (a, e) = ([0.0, 0.6, 0.8], [1.0, 0.0, 0.0]);
         let t = [0.0, 0.0];
-        let closed = |j: Mat<f64>| three_cable_joint(&mut block_of(&j, vec![0, 1]), &t);
+        let closed = |j: Mat<f64>| block_of(&j, vec![0, 1]).closed_joint(&t);
         assert!(closed(block(a, e, 1e-5)));
         assert!(!closed(block(a, e, 1e-7)));
         assert!(!closed(block(a, e, 0.0)));
@@ -292,7 +314,7 @@ mod triangular_tests {
             let t: Vec<f64> = (0..dof).map(|d| 0.3 * (d as f64 + 1.0).sin()).collect();
             let mut closed = block_of(&j, dofs.clone());
             let mut scratch = Triangular::default();
-            assert!(triangular(&mut closed, &groups, &t, &mut scratch), "the routed shape");
+            assert!(closed.closed_chain(&groups, &t, &mut scratch), "the routed shape");
             let (fp, null, pinv) = (&closed.particular, columns(&closed), &closed.pseudo_inverse);
             let mut svd = block_of(&j, dofs.clone());
             svd.by_svd(&t).unwrap();
@@ -354,7 +376,7 @@ mod triangular_tests {
         let joints: Vec<Range<usize>> = (0..3).map(|l| 2 * l..2 * l + 2).collect();
         let tri = |j: MatRef<'_, f64>, groups: &[Range<usize>]| {
             let mut b = block_of(&j.to_owned(), dofs.clone());
-            triangular(&mut b, groups, &t, &mut Triangular::default())
+            b.closed_chain(groups, &t, &mut Triangular::default())
         };
         assert!(tri(j.as_ref(), &joints));
         // Joints of three DOFs are not universal joints.

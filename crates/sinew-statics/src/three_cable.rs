@@ -21,7 +21,7 @@
 
 use std::ops::Range;
 
-use crate::set_block::Block;
+use faer::{Mat, MatRef};
 
 /// The closed form of a three-cable joint is taken when its smallest singular value is at least
 /// this fraction of its largest.
@@ -58,24 +58,30 @@ fn joint_pieces(a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [[f64; 2]; 3])> {
     Some((n, inverse))
 }
 
-/// The closed form of a 3 × 2 block (its `range` on entry) under the torques `t`: `f_p`, `n`
-/// and `J⁺` into the block; `false` (the block untouched) for another shape or a block too
-/// close to rank 1.
-pub(crate) fn three_cable_joint(block: &mut Block, t: &[f64]) -> bool {
-    let j = block.range.as_ref();
+/// A block's share of the equilibrium set, written by the closed forms: `f_p` on its cables,
+/// its columns of `N` (cables × columns) and `J⁺` (DOFs × cables), in the block's order.
+pub(crate) struct Share<'a> {
+    pub(crate) particular: &'a mut Vec<f64>,
+    pub(crate) null: &'a mut Mat<f64>,
+    pub(crate) pseudo_inverse: &'a mut Mat<f64>,
+}
+
+/// The closed form of a 3 × 2 block `j` under the torques `t`: `f_p`, `n` and `J⁺` into
+/// `out`; `false` (`out` untouched) for another shape or a block too close to rank 1.
+pub(crate) fn three_cable_joint(j: MatRef<'_, f64>, t: &[f64], out: Share<'_>) -> bool {
     if j.nrows() != 3 || j.ncols() != 2 {
         return false;
     }
     let column = |d: usize| [j[(0, d)], j[(1, d)], j[(2, d)]];
     let Some((n, inverse)) = joint_pieces(column(0), column(1)) else { return false };
-    block.particular.clear();
-    block.particular.extend((0..3).map(|c| -(inverse[c][0] * t[0] + inverse[c][1] * t[1])));
-    block.null.resize_with(3, 1, |_, _| 0.0);
-    block.pseudo_inverse.resize_with(2, 3, |_, _| 0.0);
+    out.particular.clear();
+    out.particular.extend((0..3).map(|c| -(inverse[c][0] * t[0] + inverse[c][1] * t[1])));
+    out.null.resize_with(3, 1, |_, _| 0.0);
+    out.pseudo_inverse.resize_with(2, 3, |_, _| 0.0);
     for c in 0..3 {
-        block.null[(c, 0)] = n[c];
+        out.null[(c, 0)] = n[c];
         for d in 0..2 {
-            block.pseudo_inverse[(d, c)] = inverse[c][d];
+            out.pseudo_inverse[(d, c)] = inverse[c][d];
         }
     }
     true
@@ -97,19 +103,18 @@ pub(crate) struct Triangular {
     column: Vec<f64>,
 }
 
-/// The routed arm's block-triangular closed form (module docs) of `block` (its `range`, cables
-/// × DOFs, on entry; its `dofs` global) under the torques `t` (on the block's DOFs), with the
-/// arm's joints `groups`: `f_p`, `N`'s columns and `J⁺` into the block; `false` (the block's
-/// share untouched) when the block does not have the shape (two DOFs per joint, three cables
-/// ending at each) or a joint's own block is too close to rank 1.
+/// The routed arm's block-triangular closed form (module docs) of the block `j` (cables ×
+/// DOFs, its `dofs` global) under the torques `t` (on the block's DOFs), with the arm's joints
+/// `groups`: `f_p`, `N`'s columns and `J⁺` into `out`; `false` (`out` untouched) when the block
+/// does not have the shape (two DOFs per joint, three cables ending at each) or a joint's own
+/// block is too close to rank 1.
 pub(crate) fn triangular(
-    block: &mut Block,
+    (j, dofs): (MatRef<'_, f64>, &[usize]),
     groups: &[Range<usize>],
     t: &[f64],
     s: &mut Triangular,
+    out: Share<'_>,
 ) -> bool {
-    let j = block.range.as_ref();
-    let dofs = &block.dofs;
     let (m, dof) = (j.nrows(), j.ncols());
     // The block's joints: consecutive pairs of its DOFs, each a whole joint of the arm.
     if dof % 2 != 0 || m != 3 * dof / 2 {
@@ -200,8 +205,8 @@ pub(crate) fn triangular(
     s.rhs.iter_mut().zip(t).for_each(|(r, t)| *r = -t);
     solve(&s.rhs, joints, joints - 1, &mut s.column);
     project(&mut s.column);
-    block.particular.clone_from(&s.column);
-    block.pseudo_inverse.resize_with(dof, m, |_, _| 0.0);
+    out.particular.clone_from(&s.column);
+    out.pseudo_inverse.resize_with(dof, m, |_, _| 0.0);
     for d in 0..dof {
         s.rhs.fill(0.0);
         s.rhs[d] = 1.0;
@@ -211,13 +216,13 @@ pub(crate) fn triangular(
         solve(&s.rhs, d / 2 + 1, d / 2, &mut s.column);
         project(&mut s.column);
         for (c, v) in s.column.iter().enumerate() {
-            block.pseudo_inverse[(d, c)] = *v;
+            out.pseudo_inverse[(d, c)] = *v;
         }
     }
-    block.null.resize_with(m, joints, |_, _| 0.0);
+    out.null.resize_with(m, joints, |_, _| 0.0);
     for (i, u) in null.chunks_exact(m).enumerate() {
         for (c, v) in u.iter().enumerate() {
-            block.null[(c, i)] = *v;
+            out.null[(c, i)] = *v;
         }
     }
     true
