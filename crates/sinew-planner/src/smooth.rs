@@ -40,6 +40,12 @@ pub(crate) struct EndObjective<'a> {
     pub(crate) frame: &'a Frame,
     pub(crate) kind: Kind,
     pub(crate) scale: f64,
+    b: EndBuffers,
+}
+
+/// The buffers of an [`EndObjective`], kept between objectives ([`EndObjective::reusing`]).
+#[derive(Debug, Default)]
+pub(crate) struct EndBuffers {
     /// The Cholesky factor of `A(x)`.
     a: Vec<f64>,
     /// `Yᵀ = J_x A⁻¹` (6 × n).
@@ -55,20 +61,6 @@ pub(crate) struct EndObjective<'a> {
     ta: Vec<f64>,
     kta: Vec<f64>,
     /// `G_a = zsᵀ A_a zs` (k × c × c).
-    g: Vec<f64>,
-}
-
-/// The buffers of an [`EndObjective`] (its fields of the same names), kept between objectives.
-#[derive(Debug, Default)]
-pub(crate) struct EndBuffers {
-    a: Vec<f64>,
-    yt: Vec<f64>,
-    supports: Vec<std::ops::Range<usize>>,
-    zs: Vec<f64>,
-    az: Vec<f64>,
-    la: Vec<f64>,
-    ta: Vec<f64>,
-    kta: Vec<f64>,
     g: Vec<f64>,
 }
 
@@ -109,8 +101,7 @@ impl<'a> EndObjective<'a> {
 
     /// The buffers, for a later objective ([`Self::reusing`]).
     pub(crate) fn into_buffers(self) -> EndBuffers {
-        let EndObjective { a, yt, supports, zs, az, la, ta, kta, g, .. } = self;
-        EndBuffers { a, yt, supports, zs, az, la, ta, kta, g }
+        self.b
     }
 
     fn in_buffers(
@@ -118,31 +109,24 @@ impl<'a> EndObjective<'a> {
         kind: Kind,
         scale: f64,
         c: usize,
-        b: EndBuffers,
+        mut b: EndBuffers,
     ) -> EndObjective<'a> {
         let (n, k) = (frame.n, frame.vars());
         let k = if c == 0 { 0 } else { k };
-        let sized = |mut v: Vec<f64>, len: usize| {
+        let sized = |v: &mut Vec<f64>, len: usize| {
             v.clear();
             v.resize(len, 0.0);
-            v
         };
-        let mut supports = b.supports;
-        supports.clone_from(&frame.spans);
-        EndObjective {
-            frame,
-            kind,
-            scale,
-            a: sized(b.a, n * n),
-            yt: sized(b.yt, 6 * n),
-            supports,
-            zs: sized(b.zs, c * n),
-            az: sized(b.az, k * c * n),
-            la: sized(b.la, k * c * n),
-            ta: sized(b.ta, k * c * 6),
-            kta: sized(b.kta, k * c * 6),
-            g: sized(b.g, k * c * c),
-        }
+        sized(&mut b.a, n * n);
+        sized(&mut b.yt, 6 * n);
+        b.supports.clone_from(&frame.spans);
+        sized(&mut b.zs, c * n);
+        sized(&mut b.az, k * c * n);
+        sized(&mut b.la, k * c * n);
+        sized(&mut b.ta, k * c * 6);
+        sized(&mut b.kta, k * c * 6);
+        sized(&mut b.g, k * c * c);
+        EndObjective { frame, kind, scale, b }
     }
 
     /// Factor `A(x)` and form `Y`, `C_x`, `K_x`; `None` where `A` is not positive definite or
@@ -150,36 +134,37 @@ impl<'a> EndObjective<'a> {
     #[inline(always)]
     pub(crate) fn end_at(&mut self, x: &[f64]) -> Option<EndAt> {
         let n = self.frame.n;
-        self.frame.a_at(x, &mut self.a);
-        if !cholesky(&mut self.a, n) {
+        self.frame.a_at(x, &mut self.b.a);
+        if !cholesky(&mut self.b.a, n) {
             return None;
         }
         let j_x = &self.frame.j_x;
-        self.yt.copy_from_slice(&j_x[..6 * n]);
-        for row in self.yt.chunks_exact_mut(n) {
-            cholesky_solve(&self.a, n, row);
+        self.b.yt.copy_from_slice(&j_x[..6 * n]);
+        for row in self.b.yt.chunks_exact_mut(n) {
+            cholesky_solve(&self.b.a, n, row);
         }
-        let c_x = Matrix6::from_fn(|r, c| dot(&j_x[r * n..r * n + n], &self.yt[c * n..c * n + n]));
+        let c_x =
+            Matrix6::from_fn(|r, c| dot(&j_x[r * n..r * n + n], &self.b.yt[c * n..c * n + n]));
         let c_x = 0.5 * (c_x + c_x.transpose());
         let k_x = compliance_inverse(&c_x).ok()?;
         Some(EndAt { k_x: 0.5 * (k_x + k_x.transpose()) })
     }
 
-    /// `z_j = Y K_x m_j` for the 6-vectors `columns` into `self.zs`.
+    /// `z_j = Y K_x m_j` for the 6-vectors `columns` into `self.b.zs`.
     #[inline(always)]
     fn v_times(&mut self, k_x: &Matrix6<f64>, columns: &[Vector6<f64>]) {
         let n = self.frame.n;
-        for (m, z) in columns.iter().zip(self.zs.chunks_exact_mut(n)) {
+        for (m, z) in columns.iter().zip(self.b.zs.chunks_exact_mut(n)) {
             let km = k_x * m;
             z.fill(0.0);
-            for (i, row) in self.yt.chunks_exact(n).enumerate() {
+            for (i, row) in self.b.yt.chunks_exact(n).enumerate() {
                 axpy(km[i], row, z);
             }
         }
     }
 
     /// The gradient and Hessian (unscaled) of the form with the `c` vectors `z_j` in
-    /// `self.zs`, the 3 × 3 `G_a` terms when `volume`.
+    /// `self.b.zs`, the 3 × 3 `G_a` terms when `volume`.
     #[inline(always)]
     fn forms(
         &mut self,
@@ -191,11 +176,11 @@ impl<'a> EndObjective<'a> {
     ) {
         let n = self.frame.n;
         let k = self.frame.vars();
-        let zs = &self.zs[..c * n];
+        let zs = &self.b.zs[..c * n];
         // A_a z_j over the rows where A_a is not zero (A_a symmetric: rows against z).
-        for (a, (ai, rows)) in self.frame.ai.iter().zip(&self.supports).enumerate() {
+        for (a, (ai, rows)) in self.frame.ai.iter().zip(&self.b.supports).enumerate() {
             for (j, z) in zs.chunks_exact(n).enumerate() {
-                let out = &mut self.az[(a * c + j) * n..(a * c + j + 1) * n];
+                let out = &mut self.b.az[(a * c + j) * n..(a * c + j + 1) * n];
                 out.fill(0.0);
                 let w = rows.len();
                 for (r, row) in rows.clone().zip(ai.chunks_exact(w.max(1))) {
@@ -208,10 +193,10 @@ impl<'a> EndObjective<'a> {
             let mut trace = 0.0;
             for i in 0..c {
                 for j in 0..c {
-                    let rows = self.supports[a].clone();
+                    let rows = self.b.supports[a].clone();
                     let z = &zs[i * n..i * n + n][rows.clone()];
-                    let v = dot(z, &self.az[(a * c + j) * n..][..n][rows]);
-                    self.g[a * c * c + i * c + j] = v;
+                    let v = dot(z, &self.b.az[(a * c + j) * n..][..n][rows]);
+                    self.b.g[a * c * c + i * c + j] = v;
                     if i == j {
                         trace += v;
                     }
@@ -220,31 +205,36 @@ impl<'a> EndObjective<'a> {
             gradient[a] = trace;
         }
         // L⁻¹ A_a z_j from the span's first row, and Yᵀ A_a z_j over the span.
-        for (a, rows) in self.supports.iter().enumerate() {
+        for (a, rows) in self.b.supports.iter().enumerate() {
             for j in 0..c {
                 let at = (a * c + j) * n;
-                let (az, la) = (&self.az[at..at + n], &mut self.la[at..at + n]);
+                let (az, la) = (&self.b.az[at..at + n], &mut self.b.la[at..at + n]);
                 la.copy_from_slice(az);
-                forward_solve_from(&self.a, n, la, rows.start.min(n));
+                forward_solve_from(&self.b.a, n, la, rows.start.min(n));
                 let t = Vector6::from_fn(|i, _| {
-                    dot(&self.yt[i * n..i * n + n][rows.clone()], &az[rows.clone()])
+                    dot(&self.b.yt[i * n..i * n + n][rows.clone()], &az[rows.clone()])
                 });
-                self.ta[(a * c + j) * 6..][..6].copy_from_slice(t.as_slice());
-                self.kta[(a * c + j) * 6..][..6].copy_from_slice((k_x * t).as_slice());
+                self.b.ta[(a * c + j) * 6..][..6].copy_from_slice(t.as_slice());
+                self.b.kta[(a * c + j) * 6..][..6].copy_from_slice((k_x * t).as_slice());
             }
         }
         for a in 0..k {
             for b in a..k {
-                let from = self.supports[a].start.max(self.supports[b].start).min(n);
+                let from = self.b.supports[a].start.max(self.b.supports[b].start).min(n);
                 let mut cross = 0.0;
                 for j in 0..c {
                     let (ra, rb) = ((a * c + j) * n, (b * c + j) * n);
-                    cross += dot(&self.la[ra + from..ra + n], &self.la[rb + from..rb + n]);
-                    cross -=
-                        dot(&self.ta[(a * c + j) * 6..][..6], &self.kta[(b * c + j) * 6..][..6]);
+                    cross += dot(&self.b.la[ra + from..ra + n], &self.b.la[rb + from..rb + n]);
+                    cross -= dot(
+                        &self.b.ta[(a * c + j) * 6..][..6],
+                        &self.b.kta[(b * c + j) * 6..][..6],
+                    );
                 }
                 let gg = if volume {
-                    dot(&self.g[a * c * c..(a + 1) * c * c], &self.g[b * c * c..(b + 1) * c * c])
+                    dot(
+                        &self.b.g[a * c * c..(a + 1) * c * c],
+                        &self.b.g[b * c * c..(b + 1) * c * c],
+                    )
                 } else {
                     0.0
                 };
