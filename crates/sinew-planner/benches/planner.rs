@@ -125,30 +125,38 @@ fn bench_plans(c: &mut Criterion) {
         let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
         let steps: Vec<Step> =
             cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
-        let objective = Objective::StiffnessAlong(Vector3::y());
         let settings = PlanSettings::default();
-        let along = planner
-            .plan_along(&mut data, &steps, objective, &requirements, &settings, None)
-            .unwrap();
-        let warm = along.iter().filter(|s| s.warm).count();
-        let mut iterations: Vec<usize> = along.iter().map(|s| s.iterations).collect();
-        iterations.sort_unstable();
-        println!(
-            "cdhrm5 {name} along 100 steps: {warm} warm, median iterations {}",
-            iterations[50]
-        );
-        group.bench_function(format!("cdhrm5 {name} along 100 steps stiffness-along"), |b| {
-            b.iter(|| {
-                planner.plan_along(
-                    &mut data,
-                    black_box(&steps),
-                    objective,
-                    &requirements,
-                    &settings,
-                    None,
-                )
-            })
-        });
+        for objective in [
+            Objective::StiffnessAlong(Vector3::y()),
+            Objective::ComplianceAlong(Vector3::y()),
+            Objective::MinStiffness,
+            Objective::Volume,
+            Objective::LeastTension,
+        ] {
+            let along = planner
+                .plan_along(&mut data, &steps, objective, &requirements, &settings, None)
+                .unwrap();
+            let warm = along.iter().filter(|s| s.warm).count();
+            let mut iterations: Vec<usize> = along.iter().map(|s| s.iterations).collect();
+            iterations.sort_unstable();
+            let label = objective.name();
+            println!(
+                "cdhrm5 {name} along 100 steps {label}: {warm} warm, median iterations {}",
+                iterations[50]
+            );
+            group.bench_function(format!("cdhrm5 {name} along 100 steps {label}"), |b| {
+                b.iter(|| {
+                    planner.plan_along(
+                        &mut data,
+                        black_box(&steps),
+                        objective,
+                        &requirements,
+                        &settings,
+                        None,
+                    )
+                })
+            });
+        }
     }
     let (robot, routing) = cdhrm5::chain(25, PatternModel::Decoupled);
     let robot = robot.with_gravity(Vector3::zeros());

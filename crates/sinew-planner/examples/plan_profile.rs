@@ -68,6 +68,9 @@ fn main() {
                 .plan_along(&mut data, black_box(&steps), objective, &requirements, &settings, None)
                 .unwrap();
             warm = along.iter().filter(|s| s.warm).count();
+            if std::env::var("SHOW").is_ok() {
+                eprintln!("{:?}", along.iter().map(|s| (s.warm, s.iterations)).collect::<Vec<_>>());
+            }
         }
         println!("{warm} of 100 steps warm");
         return;

@@ -81,7 +81,13 @@ fn smooth_gradients_and_hessians_match_central_differences_and_are_concave() {
     for model in cdhrm5::MODELS {
         let f = frame(model);
         let k = f.vars();
-        for kind in [Kind::Along(Vector6::new(0.0, 0.6, 0.8, 0.0, 0.0, 0.0)), Kind::Volume] {
+        let kinds = [
+            Kind::Along(Vector6::new(0.0, 0.6, 0.8, 0.0, 0.0, 0.0)),
+            Kind::Volume,
+            Kind::Compliance(nalgebra::Vector3::new(0.6, 0.0, 0.8)),
+            Kind::Least,
+        ];
+        for kind in kinds {
             let mut objective = EndObjective::new(&f, kind, 1.0);
             let (mut worst_g, mut worst_h) = (0.0_f64, 0.0_f64);
             for x in stable_points(&f, 1e-3, 6, 7) {
@@ -319,5 +325,39 @@ fn a_floors_factored_schur_terms_are_its_dense_ones() {
         for (e, (u, v)) in a.iter().zip(&d).enumerate() {
             assert!((u - v).abs() <= 1e-11 * size, "{tau:?}: entry {e}: {u} against {v}");
         }
+    }
+}
+
+/// The margin's linearisation on both cdhrm5 frames (the frame's `A_a v` by spans) against
+/// central differences of an eigensolver's least eigenvalue of `A(x)`.
+#[test]
+fn the_margin_row_is_the_least_eigenvalue_of_the_frames_pencil() {
+    let least = |f: &Frame, x: &[f64]| {
+        let mut a = vec![0.0; f.n * f.n];
+        f.a_at(x, &mut a);
+        DMatrix::from_row_slice(f.n, f.n, &a).symmetric_eigenvalues().min()
+    };
+    let mut row = crate::margin_row::MarginRow::default();
+    for model in cdhrm5::MODELS {
+        let f = frame(model);
+        let (n, k) = (f.n, f.vars());
+        let mut worst: f64 = 0.0;
+        for x in stable_points(&f, 1e-3, 5, 17) {
+            let mut a = vec![0.0; n * n];
+            f.a_at(&x, &mut a);
+            assert!(row.linearise(&a, n, k, |i, v, out| f.ai_apply(i, v, out)), "{model:?}");
+            assert!((row.rho - least(&f, &x)).abs() <= 1e-12 * f.a_scale, "{model:?}");
+            let scale = row.gradient.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            for i in 0..k {
+                let h = 1e-6;
+                let (mut up, mut down) = (x.clone(), x.clone());
+                up[i] += h;
+                down[i] -= h;
+                let fd = (least(&f, &up) - least(&f, &down)) / (2.0 * h);
+                worst = worst.max((fd - row.gradient[i]).abs() / scale);
+            }
+        }
+        println!("{model:?}: margin gradient error {worst:.1e}");
+        assert!(worst <= 5e-8, "{model:?}: margin gradient error {worst:e}");
     }
 }

@@ -274,6 +274,16 @@ impl Frame {
             .sum()
     }
 
+    /// `out = (∂A/∂x_a) v` (n).
+    pub(crate) fn ai_apply(&self, a: usize, v: &[f64], out: &mut [f64]) {
+        let span = self.spans[a].clone();
+        let w = span.len();
+        out.fill(0.0);
+        for (o, row) in out[span.clone()].iter_mut().zip(self.ai[a].chunks_exact(w.max(1))) {
+            *o = row.iter().zip(&v[span.clone()]).map(|(e, vc)| e * vc).sum();
+        }
+    }
+
     /// `R`: an orthonormal basis of `null(J_r)` (n × (n − 3), row-major), by Gram–Schmidt
     /// twice on the rotation rows and then the unit vectors; `None` when `J_r` has rank < 3.
     pub(crate) fn rotation_null_basis(&self) -> Option<Vec<f64>> {

@@ -330,20 +330,17 @@ impl<'a> Interior<'a> {
             Objective::StiffnessAlong(_) | Objective::Volume => {
                 let mut sdp = base(self.frame, 0);
                 sdp.blocks = self.constraint_blocks(floors, 0, lazy)?;
-                let kind = match self.objective {
-                    Objective::StiffnessAlong(u) => {
-                        Kind::Along(Vector6::new(u.x, u.y, u.z, 0., 0., 0.))
-                    }
-                    _ => Kind::Volume,
-                };
                 let k_x = self.k_x_at(x).ok_or(PlanError::NoEndStiffness)?;
-                let now = match kind {
-                    Kind::Along(w) => w.dot(&(k_x * w)),
-                    Kind::Volume => k_x.fixed_view::<3, 3>(0, 0).determinant().ln(),
+                let (kind, now) = match self.objective {
+                    Objective::StiffnessAlong(u) => {
+                        let w = Vector6::new(u.x, u.y, u.z, 0., 0., 0.);
+                        (Kind::Along(w), w.dot(&(k_x * w)))
+                    }
+                    _ => (Kind::Volume, k_x.fixed_view::<3, 3>(0, 0).determinant().ln()),
                 };
                 let scale = match kind {
                     Kind::Volume => now.abs().max(1.0),
-                    Kind::Along(_) => now.abs().max(1e-12),
+                    _ => now.abs().max(1e-12),
                 };
                 if matches!(kind, Kind::Volume) {
                     // The gap's absolute floor: 1 in log units.

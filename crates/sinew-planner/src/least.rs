@@ -49,6 +49,12 @@ impl LeastEigen {
         self.x.fill(1.0 / (n as f64).sqrt());
     }
 
+    /// The last call's vector: the unit iterate of inverse iteration, close to the least
+    /// eigenvector when the call converged by it.
+    pub(crate) fn vector(&self) -> &[f64] {
+        &self.x
+    }
+
     /// The least eigenvalue of the symmetric `a` (n × n, row-major; both triangles read),
     /// bracketed to `1e-10 max |a_ij|`; `below`, when given, is known to be below it (a stable arm: 0).
     /// `None` when `a` has an entry that is not finite.

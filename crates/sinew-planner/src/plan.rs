@@ -73,6 +73,7 @@ impl PlannerData {
     pub(crate) fn forget(&mut self) {
         self.previous = None;
         self.margin.1.forget();
+        self.warm.forget();
     }
 
     /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its

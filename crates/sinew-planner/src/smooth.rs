@@ -13,7 +13,14 @@
 //! `w_a = L⁻¹ A_a z` (a forward substitution from the first row where `A_a` is not zero) and
 //! `t_a = Yᵀ A_a z`: no full solve per coefficient.
 //!
-//! Both Hessians are `⪯ 0` (Gram forms with `P ⪰ 0`): the objectives are concave, as
+//! - `φ = −wᵀ A⁻¹ w`, `w = J_pᵀ u` (the compliance along `u`, rotations free), `z = A⁻¹ w`:
+//!   `∂_a φ = zᵀ A_a z`, `∂_ab φ = −2 (A_a z)ᵀ A⁻¹ (A_b z) = −2 w_aᵀ w_b`.
+//!
+//! - `φ = λ_min(K_fd)` where it is simple, `K_fd = E Λ Eᵀ` (`e₁` least), `Z = V[:, 0:3] E`,
+//!   `G_a = Zᵀ A_a Z`: `∂_a φ = G_a[0, 0]`, `∂_ab φ = −2 (A_a z₁)ᵀ P (A_b z₁) +
+//!   2 Σ_{j>1} G_a[0, j] G_b[0, j] / (λ₁ − λ_j)` (second-order perturbation of an eigenvalue).
+//!
+//! All four Hessians are `⪯ 0` (Gram forms with `P ⪰ 0`): the objectives are concave, as
 //! `wᵀ K_x w = min { δqᵀ A δq : J_x δq = w }` is a minimum of affine functions of `x`.
 
 use nalgebra::{Matrix3, Matrix6, Vector6};
@@ -30,6 +37,25 @@ pub(crate) enum Kind {
     Along(Vector6<f64>),
     /// `log det K_fd`.
     Volume,
+    /// `−uᵀ C_x[0:3, 0:3] u = −wᵀ A⁻¹ w`, `w = J_pᵀ u`: the compliance along `u` with the
+    /// rotations free, negated (module docs).
+    Compliance(nalgebra::Vector3<f64>),
+    /// `λ_min(K_fd)`, the least stiffness with the rotations held, where it is simple.
+    Least,
+}
+
+/// Which Hessian [`EndObjective::forms`] assembles from its vectors `z_j`.
+#[derive(Debug, Clone, Copy)]
+enum Form {
+    /// `wᵀ K_x w`: one vector.
+    Along,
+    /// `log det K_fd`: three, with `−⟨G_a, G_b⟩`.
+    Volume,
+    /// `−wᵀ A⁻¹ w`: one, `P = A⁻¹`.
+    Compliance,
+    /// `λ_min(K_fd)`: three (the eigenvectors of `K_fd`, least first), the cross terms of the
+    /// first only, with `2 Σ_j G_a[0, j] G_b[0, j] / (λ₁ − λ_j)`; the gaps `λ₁ − λ_j`.
+    Least([f64; 2]),
 }
 
 /// A smooth objective on a frame, divided by `scale`, with the buffers of its evaluations
@@ -93,8 +119,8 @@ impl<'a> EndObjective<'a> {
         buffers: EndBuffers,
     ) -> EndObjective<'a> {
         let columns = match kind {
-            Kind::Along(_) => 1,
-            Kind::Volume => 3,
+            Kind::Along(_) | Kind::Compliance(_) => 1,
+            Kind::Volume | Kind::Least => 3,
         };
         Self::in_buffers(frame, kind, scale, columns, buffers)
     }
@@ -163,17 +189,21 @@ impl<'a> EndObjective<'a> {
         }
     }
 
-    /// The gradient and Hessian (unscaled) of the form with the `c` vectors `z_j` in
-    /// `self.b.zs`, the 3 × 3 `G_a` terms when `volume`.
+    /// The gradient and Hessian (unscaled) of `form` with the `c` vectors `z_j` in
+    /// `self.b.zs` (module docs): `P = A⁻¹` instead of the constrained inverse for the
+    /// compliance, the `c × c` terms `G_a = Zᵀ A_a Z` for the volume and the least stiffness.
     #[inline(always)]
     fn forms(
         &mut self,
         k_x: &Matrix6<f64>,
         c: usize,
-        volume: bool,
+        form: Form,
         gradient: &mut [f64],
         hessian: &mut [f64],
     ) {
+        let constrained = !matches!(form, Form::Compliance);
+        // The vectors whose cross terms enter (the least stiffness: its eigenvector's only).
+        let crossed = if matches!(form, Form::Least(_)) { 1 } else { c };
         let n = self.frame.n;
         let k = self.frame.vars();
         let zs = &self.b.zs[..c * n];
@@ -197,7 +227,7 @@ impl<'a> EndObjective<'a> {
                     let z = &zs[i * n..i * n + n][rows.clone()];
                     let v = dot(z, &self.b.az[(a * c + j) * n..][..n][rows]);
                     self.b.g[a * c * c + i * c + j] = v;
-                    if i == j {
+                    if i == j && (i == 0 || !matches!(form, Form::Least(_))) {
                         trace += v;
                     }
                 }
@@ -206,11 +236,14 @@ impl<'a> EndObjective<'a> {
         }
         // L⁻¹ A_a z_j from the span's first row, and Yᵀ A_a z_j over the span.
         for (a, rows) in self.b.supports.iter().enumerate() {
-            for j in 0..c {
+            for j in 0..crossed {
                 let at = (a * c + j) * n;
                 let (az, la) = (&self.b.az[at..at + n], &mut self.b.la[at..at + n]);
                 la.copy_from_slice(az);
                 forward_solve_from(&self.b.a, n, la, rows.start.min(n));
+                if !constrained {
+                    continue;
+                }
                 let t = Vector6::from_fn(|i, _| {
                     dot(&self.b.yt[i * n..i * n + n][rows.clone()], &az[rows.clone()])
                 });
@@ -222,21 +255,24 @@ impl<'a> EndObjective<'a> {
             for b in a..k {
                 let from = self.b.supports[a].start.max(self.b.supports[b].start).min(n);
                 let mut cross = 0.0;
-                for j in 0..c {
+                for j in 0..crossed {
                     let (ra, rb) = ((a * c + j) * n, (b * c + j) * n);
                     cross += dot(&self.b.la[ra + from..ra + n], &self.b.la[rb + from..rb + n]);
+                    if !constrained {
+                        continue;
+                    }
                     cross -= dot(
                         &self.b.ta[(a * c + j) * 6..][..6],
                         &self.b.kta[(b * c + j) * 6..][..6],
                     );
                 }
-                let gg = if volume {
-                    dot(
-                        &self.b.g[a * c * c..(a + 1) * c * c],
-                        &self.b.g[b * c * c..(b + 1) * c * c],
-                    )
-                } else {
-                    0.0
+                let (ga, gb) = (&self.b.g[a * c * c..][..c * c], &self.b.g[b * c * c..][..c * c]);
+                let gg = match form {
+                    Form::Volume => dot(ga, gb),
+                    Form::Least(gaps) => {
+                        -2.0 * (1..c).map(|j| ga[j] * gb[j] / gaps[j - 1]).sum::<f64>()
+                    }
+                    Form::Along | Form::Compliance => 0.0,
                 };
                 hessian[a * k + b] = -2.0 * cross - gg;
                 hessian[b * k + a] = -2.0 * cross - gg;
@@ -284,7 +320,7 @@ impl EndObjective<'_> {
         let value = match self.kind {
             Kind::Along(w) => {
                 self.v_times(&k_x, &[w]);
-                self.forms(&k_x, 1, false, gradient, hessian);
+                self.forms(&k_x, 1, Form::Along, gradient, hessian);
                 w.dot(&(k_x * w))
             }
             Kind::Volume => {
@@ -296,8 +332,42 @@ impl EndObjective<'_> {
                     Vector6::from_fn(|r, _| if r < 3 { l_inv_t[(r, a)] } else { 0.0 })
                 });
                 self.v_times(&k_x, &columns);
-                self.forms(&k_x, 3, true, gradient, hessian);
+                self.forms(&k_x, 3, Form::Volume, gradient, hessian);
                 2.0 * (0..3).map(|i| l[(i, i)].ln()).sum::<f64>()
+            }
+            Kind::Compliance(u) => {
+                // z = A⁻¹ J_pᵀ u from the rows of Yᵀ = J_x A⁻¹; φ = −(J_pᵀ u)ᵀ z.
+                let n = self.frame.n;
+                let z = &mut self.b.zs[..n];
+                z.fill(0.0);
+                for (i, row) in self.b.yt.chunks_exact(n).take(3).enumerate() {
+                    axpy(u[i], row, z);
+                }
+                let j_x = &self.frame.j_x;
+                let value: f64 = (0..3).map(|i| -u[i] * dot(&j_x[i * n..i * n + n], z)).sum();
+                self.forms(&k_x, 1, Form::Compliance, gradient, hessian);
+                value
+            }
+            Kind::Least => {
+                let k_fd: Matrix3<f64> = k_x.fixed_view::<3, 3>(0, 0).into_owned();
+                let eigen = (0.5 * (k_fd + k_fd.transpose())).symmetric_eigen();
+                let mut order = [0, 1, 2];
+                order.sort_by(|i, j| eigen.eigenvalues[*i].total_cmp(&eigen.eigenvalues[*j]));
+                let lambda = order.map(|i| eigen.eigenvalues[i]);
+                let gaps = [lambda[0] - lambda[1], lambda[0] - lambda[2]];
+                // A least eigenvalue within 1e-9 of the next is repeated to rounding: there
+                // `λ_min` has no gradient.
+                if gaps.iter().any(|g| g.is_nan() || *g >= -1e-9 * lambda[2].abs()) {
+                    return None;
+                }
+                let columns: [Vector6<f64>; 3] = std::array::from_fn(|j| {
+                    Vector6::from_fn(
+                        |r, _| if r < 3 { eigen.eigenvectors[(r, order[j])] } else { 0.0 },
+                    )
+                });
+                self.v_times(&k_x, &columns);
+                self.forms(&k_x, 3, Form::Least(gaps), gradient, hessian);
+                lambda[0]
             }
         };
         let s = 1.0 / self.scale;

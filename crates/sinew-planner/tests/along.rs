@@ -38,18 +38,17 @@ fn run(
 #[test]
 fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
     let steps = trajectory(1000);
-    // The Newton steps on the previous active set (smooth objectives, least tension with the
-    // margin not active) take one or two evaluations where the interior-point method's warm
-    // start takes four or more: `Some(2)` bounds the median for those. Decoupled least tension
-    // sits on the stability margin, which the Newton steps leave to the interior-point method
-    // (and its warm start to the cold one at four steps in ten): every plan must still
-    // hold the margin.
-    for (model, objective, newton, least_warm) in [
-        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y()), Some(2), 900),
-        (PatternModel::Routed, Objective::Volume, Some(2), 900),
-        (PatternModel::Routed, Objective::LeastTension, Some(2), 900),
-        (PatternModel::Decoupled, Objective::LeastTension, None, 500),
-        (PatternModel::Routed, Objective::MinStiffness, None, 900),
+    // The Newton steps on the previous active set take one to three evaluations where the
+    // interior-point method's warm start takes ten: `newton` bounds the median. Decoupled
+    // least tension sits on the stability margin for part of the trajectory (`bound`: at least
+    // this many steps with the margin binding), which the steps take into their working set.
+    for (model, objective, newton, bound) in [
+        (PatternModel::Decoupled, Objective::StiffnessAlong(Vector3::y()), 1, 0),
+        (PatternModel::Decoupled, Objective::ComplianceAlong(Vector3::y()), 1, 0),
+        (PatternModel::Routed, Objective::Volume, 1, 0),
+        (PatternModel::Routed, Objective::LeastTension, 1, 0),
+        (PatternModel::Decoupled, Objective::LeastTension, 3, 500),
+        (PatternModel::Routed, Objective::MinStiffness, 1, 0),
     ] {
         let (robot, routing) = cdhrm5::robot_and_routing(model);
         let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
@@ -57,6 +56,7 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
         let mut data = PlannerData::new(&planner);
         let settings = PlanSettings::default();
         let mut warm = 0;
+        let mut binding = 0;
         let mut iterations = Vec::new();
         for (k, (step, result)) in steps.iter().zip(&along).enumerate() {
             let plan = result.plan.as_ref().unwrap_or_else(|e| panic!("step {k}: {e}"));
@@ -71,6 +71,8 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
                 "step {k}: margin {}",
                 plan.min_eigenvalue
             );
+            // Within 1e-6 N m/rad of the margin: binding (the answers keep a δ of about 1e-7).
+            binding += usize::from(plan.min_eigenvalue <= margin + 1e-6);
             warm += usize::from(result.warm);
             if result.warm {
                 iterations.push(result.iterations);
@@ -98,14 +100,14 @@ fn a_thousand_steps_are_certified_warm_equals_cold_and_runs_repeat() {
         iterations.sort_unstable();
         let median = iterations.get(iterations.len() / 2).copied().unwrap_or(0);
         println!(
-            "{model:?} {}: {warm} of 1000 steps warm, median warm iterations {median}",
+            "{model:?} {}: {warm} of 1000 steps warm, median warm iterations {median}, \
+             margin binding at {binding}",
             objective.name()
         );
         // The warm path is the rule along a smooth trajectory, not the exception.
-        assert!(warm >= least_warm, "only {warm} warm steps");
-        if let Some(most) = newton {
-            assert!(median <= most, "median warm iterations {median}: not the Newton steps");
-        }
+        assert!(warm >= 990, "only {warm} warm steps");
+        assert!(median <= newton, "median warm iterations {median}: not the Newton steps");
+        assert!(binding >= bound, "the margin binds at {binding} steps only");
         // Deterministic: a second run gives the same bits.
         let again = run(&planner, &steps, objective, None);
         for (a, b) in along.iter().zip(&again) {
