@@ -62,17 +62,17 @@ fn main() {
         let steps: Vec<Step> =
             cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
         let settings = PlanSettings::default();
-        let mut warm = 0;
+        let (mut warm, mut median) = (0, 0);
         for _ in 0..plans {
             let along = planner
                 .plan_along(&mut data, black_box(&steps), objective, &requirements, &settings, None)
                 .unwrap();
             warm = along.iter().filter(|s| s.warm).count();
-            if std::env::var("SHOW").is_ok() {
-                eprintln!("{:?}", along.iter().map(|s| (s.warm, s.iterations)).collect::<Vec<_>>());
-            }
+            let mut iterations: Vec<usize> = along.iter().map(|s| s.iterations).collect();
+            iterations.sort_unstable();
+            median = iterations[iterations.len() / 2];
         }
-        println!("{warm} of 100 steps warm");
+        println!("{warm} of 100 steps warm, median iterations or evaluations {median}");
         return;
     }
     let mut settings = PlanSettings { method, ..PlanSettings::default() };
