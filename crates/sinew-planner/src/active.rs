@@ -259,7 +259,8 @@ fn steps(
         }
         let mut inside = cholesky(a, n);
         if !inside && !with_margin {
-            if active.len() >= k {
+            // At the mapped point the margin takes the loosest row's place in a full set.
+            if k == 0 || (active.len() >= k && near == 0.0) {
                 return Err(step);
             }
             active.truncate(k - 1);
