@@ -126,13 +126,7 @@ fn bench_plans(c: &mut Criterion) {
         let steps: Vec<Step> =
             cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
         let settings = PlanSettings::default();
-        for objective in [
-            Objective::StiffnessAlong(Vector3::y()),
-            Objective::ComplianceAlong(Vector3::y()),
-            Objective::MinStiffness,
-            Objective::Volume,
-            Objective::LeastTension,
-        ] {
+        for objective in objectives() {
             let along = planner
                 .plan_along(&mut data, &steps, objective, &requirements, &settings, None)
                 .unwrap();

@@ -80,8 +80,8 @@ pub(crate) fn multipliers(
     let mut eta = 0.0;
     if p > 0 {
         let column = |i: usize| match (active[i], c_gradient) {
-            (MARGIN, Some(c)) => (c, -1.0),
-            (MARGIN, None) => (&frame.sums[..0], 0.0),
+            // Without `c_gradient` (not in the set) the margin's column is empty.
+            (MARGIN, c) => (c.unwrap_or(&[]), -1.0),
             (r, _) => (&frame.rows[r * k..r * k + k], 1.0),
         };
         let product = |i: usize, j: usize| {

@@ -350,7 +350,7 @@ impl EndObjective<'_> {
             }
             Kind::Least => {
                 let k_fd: Matrix3<f64> = k_x.fixed_view::<3, 3>(0, 0).into_owned();
-                let eigen = (0.5 * (k_fd + k_fd.transpose())).symmetric_eigen();
+                let eigen = k_fd.symmetric_eigen();
                 let mut order = [0, 1, 2];
                 order.sort_by(|i, j| eigen.eigenvalues[*i].total_cmp(&eigen.eigenvalues[*j]));
                 let lambda = order.map(|i| eigen.eigenvalues[i]);

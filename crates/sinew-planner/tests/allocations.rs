@@ -23,17 +23,22 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 /// The counter is global: the tests of this binary run one at a time.
 static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-#[test]
-fn iterations_of_the_interior_point_method_allocate_nothing() {
-    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    assert_counting();
-    let objectives = [
+/// The five objectives, those along a direction along y.
+fn objectives() -> [Objective; 5] {
+    [
         Objective::StiffnessAlong(Vector3::y()),
         Objective::ComplianceAlong(Vector3::y()),
         Objective::MinStiffness,
         Objective::Volume,
         Objective::LeastTension,
-    ];
+    ]
+}
+
+#[test]
+fn iterations_of_the_interior_point_method_allocate_nothing() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    assert_counting();
+    let objectives = objectives();
     let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
     let requirements = Requirements::default();
     for model in cdhrm5::MODELS {
@@ -122,13 +127,7 @@ fn a_warm_step_allocates_only_its_plan() {
         let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
         let mut data = PlannerData::new(&planner);
         let own = 2 + usize::from(planner.arm().statics().has_levels());
-        for objective in [
-            Objective::StiffnessAlong(Vector3::y()),
-            Objective::ComplianceAlong(Vector3::y()),
-            Objective::MinStiffness,
-            Objective::Volume,
-            Objective::LeastTension,
-        ] {
+        for objective in objectives() {
             let mut run = |n: usize| {
                 let mut least = usize::MAX;
                 let mut along = Vec::new();
