@@ -4,7 +4,7 @@
 
 use faer::MatRef;
 use nalgebra::{Matrix3, Matrix6};
-use sinew_stiffness::{ArmStiffnessData, StiffnessError};
+use sinew_stiffness::StiffnessError;
 
 use crate::error::PlanError;
 use crate::least::LeastEigen;
@@ -66,18 +66,19 @@ pub(crate) fn plan_at(
     })
 }
 
-/// The stability margin of the stable arm in `sd` (its last end stage), as
-/// [`sinew_stiffness::Outcome::margin`] defines it, the least eigenvalue of `sym(K_q + K_W)`,
-/// by Cholesky trials instead of an eigendecomposition ([`LeastEigen`]; no allocation once
-/// `margin` is sized; its last eigenvector starts the next plan's).
+/// The stability margin of a stable arm, `K_q` of its last tension stage and `K_W` at its pose,
+/// as [`sinew_stiffness::Outcome::margin`] defines it, the least eigenvalue of
+/// `sym(K_q + K_W)`, by Cholesky trials instead of an eigendecomposition ([`LeastEigen`]; no
+/// allocation once `margin` is sized; its last eigenvector starts the next plan's).
 pub(crate) fn stable_margin(
-    sd: &mut ArmStiffnessData,
+    k_q: MatRef<'_, f64>,
+    k_w: MatRef<'_, f64>,
     margin: &mut (Vec<f64>, LeastEigen),
 ) -> Result<f64, PlanError> {
-    let n = sd.k_q().nrows();
+    let n = k_q.nrows();
     margin.0.resize(n * n, 0.0);
-    accumulate(&mut margin.0, sd.k_q(), false);
-    accumulate(&mut margin.0, sd.k_w(), true);
+    accumulate(&mut margin.0, k_q, false);
+    accumulate(&mut margin.0, k_w, true);
     least_symmetric(margin, Some(0.0))
 }
 

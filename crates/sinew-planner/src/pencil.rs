@@ -69,23 +69,34 @@ impl Pencil {
         // Σ_c f_p,c H_c and every A_i = Σ_c N_ci H_c in one pass over the segments' Hessians
         // (each entry summed in segment order, as `add_weighted_hessians` does), then K_i + K_W
         // entry by entry.
-        let null = set.null_basis();
-        let particular = set.particular();
+        // Each cable's weights in A_0 and in every A_i (`f_p,c`, then row c of N), read once:
+        // a cable has several segments.
+        let (null, particular) = (set.null_basis(), set.particular());
+        let targets = set.dimension() + 1;
+        self.weights.clear();
+        for (c, &p) in particular.iter().enumerate() {
+            self.weights.push(p);
+            self.weights.extend((0..targets - 1).map(|i| null[(c, i)]));
+        }
         for (seg, h) in sd.cables.segment_hessians(routing)?.iter() {
             let (lo, n, c) = (seg.dofs.start, seg.dofs.len(), seg.cable);
-            if n == 0 || h.len() != n * n || c >= set.cable_count() {
+            let Some(weights) = self.weights.get(c * targets..(c + 1) * targets) else {
+                continue;
+            };
+            if n == 0 || h.len() != n * n {
                 continue;
             }
-            add_block(&mut self.a0, lo, n, h, particular[c]);
-            for (i, a) in self.ai.iter_mut().enumerate() {
-                add_block(a, lo, n, h, null[(c, i)]);
+            let matrices = std::iter::once(&mut self.a0).chain(self.ai.iter_mut());
+            for (a, &w) in matrices.zip(weights) {
+                add_block(a, lo, n, h, w);
             }
         }
         self.k_w.copy_from(sd.k_w());
         let k_inherent = sd.k_inherent();
         for c in 0..dof {
-            for r in 0..dof {
-                self.a0[(r, c)] += k_inherent[(r, c)] + self.k_w[(r, c)];
+            let (a0, k_w) = (self.a0.col_as_slice_mut(c), self.k_w.col_as_slice(c));
+            for ((a, w), k) in a0.iter_mut().zip(k_w).zip(k_inherent.col(c).iter()) {
+                *a += k + w;
             }
         }
         self.copy_j_x(sd.j_x());
@@ -335,6 +346,17 @@ impl End {
 /// slice by column slice (`n ≥ 1`); nothing for `w = 0` (a cable outside a null column).
 fn add_block(out: &mut Mat<f64>, lo: usize, n: usize, h: &[f64], w: f64) {
     if w == 0.0 {
+        return;
+    }
+    if let ([h00, h10, h01, h11], 2) = (h, n) {
+        // A joint's 2 × 2 block (every routed and decoupled segment of the pattern): the same
+        // sums without the loops.
+        let col = &mut out.col_as_slice_mut(lo)[lo..lo + 2];
+        col[0] += w * h00;
+        col[1] += w * h10;
+        let col = &mut out.col_as_slice_mut(lo + 1)[lo..lo + 2];
+        col[0] += w * h01;
+        col[1] += w * h11;
         return;
     }
     for (k, h) in h.chunks_exact(n).enumerate() {

@@ -333,7 +333,14 @@ impl Planner {
         arm.solve_end(sd)?;
         let min_eigenvalue = match sd.outcome().ok_or(PlanError::NoEndStiffness)?.end() {
             EndOutcome::Unstable { min_eigenvalue } => min_eigenvalue,
-            _ => stable_margin(sd, &mut data.margin)?,
+            // K_W as the pencil of this pose holds it (filled from the generators once).
+            _ => match &data.pencil {
+                Some(pencil) => stable_margin(sd.k_q(), pencil.k_w.as_ref(), &mut data.margin)?,
+                None => {
+                    let k_w = sd.k_w().to_owned();
+                    stable_margin(sd.k_q(), k_w.as_ref(), &mut data.margin)?
+                }
+            },
         };
         let outcome = sd.outcome().ok_or(PlanError::NoEndStiffness)?;
         let Some(c) = outcome.compliance() else {
