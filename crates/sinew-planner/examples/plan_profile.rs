@@ -62,7 +62,7 @@ fn main() {
         let steps: Vec<Step> =
             cdhrm5::swaying_poses(100, 1e-3, 0.0).into_iter().map(|q| Step { q, f0 }).collect();
         let settings = PlanSettings::default();
-        let (mut warm, mut median) = (0, 0);
+        let (mut warm, mut median, mut digest) = (0, 0, 0_u64);
         for _ in 0..plans {
             let along = planner
                 .plan_along(&mut data, black_box(&steps), objective, &requirements, &settings, None)
@@ -71,8 +71,17 @@ fn main() {
             let mut iterations: Vec<usize> = along.iter().map(|s| s.iterations).collect();
             iterations.sort_unstable();
             median = iterations[iterations.len() / 2];
+            // Every step's tensions, value, gap and margin, bit by bit: two builds that should
+            // compute the same plans print the same digest.
+            digest = along
+                .iter()
+                .filter_map(|s| s.plan.as_ref().ok())
+                .flat_map(|p| p.tensions.iter().chain([&p.value, &p.gap, &p.min_eigenvalue]))
+                .fold(0, |h: u64, v| (h.rotate_left(5) ^ v.to_bits()).wrapping_mul(0x100000001b3));
         }
-        println!("{warm} of 100 steps warm, median iterations or evaluations {median}");
+        println!(
+            "{warm} of 100 steps warm, median iterations or evaluations {median}, digest {digest:016x}"
+        );
         return;
     }
     let mut settings = PlanSettings { method, ..PlanSettings::default() };

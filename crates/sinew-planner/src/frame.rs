@@ -71,8 +71,13 @@ pub(crate) fn lambda_box(set: &EquilibriumSet, lo: &mut Vec<f64>, hi: &mut Vec<f
 
 /// The symmetric part of the pencil's matrix `a` (`a[(r, c)]` is entry `r` of column `c`),
 /// scaled by `scale`, over the rows and columns `span` where the matrix can be non-zero (a
-/// decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`), added into `out`, row-major, a
-/// square of side `side` whose first row and column are `origin`'s.
+/// decoupled `A_i` is one 2 × 2 joint block: `Pencil::spans`), added into the lower triangle
+/// of `out`, row-major, a square of side `side` whose first row and column are `origin`'s
+/// ([`mirror_lower`] completes it once every term is in).
+///
+/// Entry `(r, c)`, `r ≥ c`, gains `0.5 s a[(r, c)]` then `0.5 s a[(c, r)]`: the two terms,
+/// in the order, that adding `0.5 s a[(r, c)]` at `(r, c)` and at `(c, r)` column by column
+/// gives either entry of a symmetric sum, so the result is that sum's bit for bit.
 fn add_symmetric(
     a: &faer::Mat<f64>,
     span: Range<usize>,
@@ -81,11 +86,23 @@ fn add_symmetric(
     side: usize,
     origin: usize,
 ) {
+    let half = 0.5 * scale;
     for c in span.clone() {
-        for (r, v) in a.col_as_slice(c)[span.clone()].iter().enumerate() {
-            let (r, c) = (r + span.start - origin, c - origin);
-            out[r * side + c] += 0.5 * scale * v;
-            out[c * side + r] += 0.5 * scale * v;
+        let column = &a.col_as_slice(c)[c..span.end];
+        let row = &mut out[(c - origin) * side..];
+        for ((k, lower), r) in column.iter().enumerate().zip(c..span.end) {
+            let upper = a.col_as_slice(r)[c];
+            let o = &mut row[k * side + (c - origin)];
+            *o = (*o + half * lower) + half * upper;
+        }
+    }
+}
+
+/// The upper triangle of the row-major square `out` (side `side`) set to its lower one's.
+fn mirror_lower(out: &mut [f64], side: usize) {
+    for r in 0..side {
+        for c in 0..r {
+            out[c * side + r] = out[r * side + c];
         }
     }
 }
@@ -163,6 +180,7 @@ impl Frame {
                 add_symmetric(a, span(i), *l, &mut self.a0, n, 0);
             }
         }
+        mirror_lower(&mut self.a0, n);
         self.spans.clear();
         self.spans.extend(self.free.iter().map(|&i| span(i)));
         self.ai.truncate(self.free.len());
@@ -174,6 +192,7 @@ impl Frame {
             out.clear();
             out.resize(side * side, 0.0);
             add_symmetric(&pencil.ai[i], span.clone(), *w, out, side, span.start);
+            mirror_lower(out, side);
         }
         self.a_scale = (0..n).map(|i| self.a0[i * n + i].abs()).fold(0.0, f64::max).max(1e-12);
         self.j_x.clear();
