@@ -9,9 +9,9 @@
 use std::hint::black_box;
 
 use nalgebra::{Vector3, Vector6};
-use sinew_routing::PatternModel;
+use sinew_routing::{FrictionModel, PatternModel, Slip};
 use sinew_statics::TensionChoice;
-use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
+use sinew_stiffness::{ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, History};
 use sinew_testkit::cdhrm5;
 
 fn main() {
@@ -23,6 +23,12 @@ fn main() {
         Some("decoupled") => PatternModel::Decoupled,
         Some(other) => panic!("unknown model {other}"),
     };
+    let regime = match args.get(4).map(String::as_str) {
+        None | Some("none") => None,
+        Some("slip") => Some(FrictionRegime::Slip(Slip::Pull)),
+        Some("stick") => Some(FrictionRegime::Stick(History::Pull)),
+        Some(other) => panic!("unknown friction {other}"),
+    };
     let (robot, routing) = cdhrm5::chain(joints, model_kind);
     let robot = robot.with_gravity(Vector3::zeros());
     let model = ArmStiffness::new(&robot, &routing).unwrap();
@@ -30,7 +36,22 @@ fn main() {
     let q: Vec<f64> = (0..2 * joints).map(|i| 0.05 * ((i as f64) * 0.7).sin()).collect();
     let levels = vec![0.1; joints];
     let f0 = Vector6::zeros();
-    model.evaluate(&mut data, &q, &f0, TensionChoice::Levels(&levels)).unwrap();
+    let choice = TensionChoice::Levels(&levels);
+    if let Some(regime) = regime {
+        let friction = FrictionModel::new(&routing).with_friction_coefficient(0.1).unwrap();
+        let mut out = FrictionArmData::new(&model, &friction);
+        // One warm-up evaluation, then `EVALS` more.
+        for _ in 0..=evals {
+            let arm = (&friction, regime);
+            model
+                .evaluate_with_friction(&mut data, &mut out, arm, black_box(&q), &f0, choice)
+                .unwrap();
+        }
+        let k = out.end.stiffness()[(0, 0)];
+        println!("{model_kind:?} {} DOF with friction ({regime:?}): K_x[0,0] = {k:e}", 2 * joints);
+        return;
+    }
+    model.evaluate(&mut data, &q, &f0, choice).unwrap();
     for _ in 0..evals {
         model.evaluate(&mut data, black_box(&q), &f0, TensionChoice::Levels(&levels)).unwrap();
     }
