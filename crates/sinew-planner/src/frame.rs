@@ -75,9 +75,9 @@ pub(crate) fn lambda_box(set: &EquilibriumSet, lo: &mut Vec<f64>, hi: &mut Vec<f
 /// of `out`, row-major, a square of side `side` whose first row and column are `origin`'s
 /// ([`mirror_lower`] completes it once every term is in).
 ///
-/// Entry `(r, c)`, `r ≥ c`, gains `0.5 s a[(r, c)]` then `0.5 s a[(c, r)]`: the two terms,
-/// in the order, that adding `0.5 s a[(r, c)]` at `(r, c)` and at `(c, r)` column by column
-/// gives either entry of a symmetric sum, so the result is that sum's bit for bit.
+/// Entry `(r, c)`, `r ≥ c`, gains `0.5 s a[(r, c)]`, then `0.5 s a[(c, r)]`. The plain double
+/// loop, which adds `0.5 s a[(r, c)]` at both `(r, c)` and `(c, r)` column by column, adds the
+/// same two terms in the same order to both entries. So the result is that loop's, bit for bit.
 fn add_symmetric(
     a: &faer::Mat<f64>,
     span: Range<usize>,
