@@ -161,17 +161,25 @@ impl LeastEigen {
         self.trials
     }
 
-    /// `ρ = xᵀAx` and `r = ‖Ax − ρx‖` of the unit iterate `x` (`Ax` into `y`).
+    /// `ρ = xᵀAx` and `r = ‖Ax − ρx‖` of the unit iterate `x` (`Ax − ρx` into `y`).
     #[inline(always)]
     fn rayleigh(&mut self, a: &[f64], n: usize) -> (f64, f64) {
-        for (yi, row) in self.y.iter_mut().zip(a.chunks_exact(n)) {
-            *yi = dot(row, &self.x);
-        }
-        let rho = dot(&self.x, &self.y);
-        let residual =
-            self.y.iter().zip(&self.x).map(|(y, x)| (y - rho * x).powi(2)).sum::<f64>().sqrt();
-        (rho, residual)
+        let rho = rayleigh_residual(a, n, &self.x, &mut self.y);
+        (rho, self.y.iter().map(|r| r * r).sum::<f64>().sqrt())
     }
+}
+
+/// The Rayleigh quotient `ρ = xᵀAx` of the unit `x` (`a` n × n, row-major), with the residual
+/// `Ax − ρx` into `r`: the least eigenvalue's estimate and its error, here and in the margin's
+/// linearisation (`margin_row.rs`).
+#[inline(always)]
+pub(crate) fn rayleigh_residual(a: &[f64], n: usize, x: &[f64], r: &mut [f64]) -> f64 {
+    for (ri, row) in r.iter_mut().zip(a.chunks_exact(n)) {
+        *ri = dot(row, x);
+    }
+    let rho = dot(x, r);
+    r.iter_mut().zip(x).for_each(|(r, x)| *r -= rho * x);
+    rho
 }
 
 /// [`LeastEigen::least`]'s arguments as a pulp operation.

@@ -29,7 +29,7 @@
 //! used, so the bound holds even where `v` is not an eigenvector; it is tight where it is.
 
 use crate::dense::{cholesky, cholesky_solve, dot};
-use crate::least::LeastEigen;
+use crate::least::{LeastEigen, rayleigh_residual};
 
 /// The residual `‖A v − ρ v‖` (of `max |a_ij|`) above which the refined vector is refused.
 const RESIDUAL: f64 = 1e-9;
@@ -138,12 +138,7 @@ impl MarginRow {
 
     /// `ρ = vᵀ A v` and `r = A v − ρ v` into `self.r`.
     fn residual(&mut self, a: &[f64], n: usize) -> f64 {
-        for (r, row) in self.r.iter_mut().zip(a.chunks_exact(n)) {
-            *r = dot(row, &self.v);
-        }
-        let rho = dot(&self.r, &self.v);
-        self.r.iter_mut().zip(&self.v).for_each(|(r, v)| *r -= rho * v);
-        rho
+        rayleigh_residual(a, n, &self.v, &mut self.r)
     }
 }
 
