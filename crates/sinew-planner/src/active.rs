@@ -39,6 +39,7 @@ use crate::blocks::base_into;
 use crate::dense::{axpy, cholesky, dot};
 use crate::frame::Frame;
 use crate::ipm::Answer;
+use crate::ipm_work::IpmWork;
 use crate::kkt::{MARGIN, multipliers, newton, slack};
 use crate::margin_row::MarginRow;
 use crate::problem::{Objective, PlanSettings, Requirements};
@@ -72,6 +73,10 @@ pub(crate) struct WarmWork {
     pub(crate) mapped: Vec<f64>,
     /// The iterate (moved into the answer; the caller returns it).
     pub(crate) x: Vec<f64>,
+    /// A forgotten plan's tensions' buffer (`PlannerData::forget`), for the next plan's.
+    pub(crate) tensions: Vec<f64>,
+    /// The buffers of the interior-point phases (a cold plan's, and a warm step's last phase).
+    pub(crate) ipm: IpmWork,
     end: EndBuffers,
     sdp: Option<Sdp>,
     active: Vec<usize>,
@@ -95,9 +100,13 @@ pub(crate) struct WarmWork {
 
 impl WarmWork {
     /// Forget the margin's last eigenvector (its buffers kept): the next plan is then a
-    /// function of its inputs alone.
-    pub(crate) fn forget(&mut self) {
+    /// function of its inputs alone. The forgotten plan's tensions' buffer, if any, is kept
+    /// for the next plan's.
+    pub(crate) fn forget(&mut self, tensions: Option<Vec<f64>>) {
         self.margin.forget();
+        if let Some(tensions) = tensions {
+            self.tensions = tensions;
+        }
     }
 
     /// The scratch of [`active_rows_into`].
@@ -304,7 +313,7 @@ fn steps(
                 bound_value += eta * c;
                 axpy(eta, &margin.gradient, bound_gradient);
             }
-            let duals = Duals { y: std::mem::take(y), z: Vec::new() };
+            let duals = Duals { y: std::mem::take(y), ..Duals::default() };
             let upper = upper_bound(sdp, x, bound_value, bound_gradient, s, empty(), &duals);
             *y = duals.y;
             if upper - value <= tolerance {

@@ -4,11 +4,13 @@
 //! math.
 
 use crate::dense::{axpy, cholesky, dot};
-use crate::program::{Block, Duals};
+use crate::program::{Block, Duals, resize_pooled};
 
 /// Per-block state of a run: the slack, its factor and inverse, the directions, scratch, and
 /// per coefficient `F_a` the rows where it is not zero with the products `F_a Z` and `S⁻¹ F_a`
-/// of the Schur complement (module docs). Allocated once per run; nothing per iteration.
+/// of the Schur complement (module docs). Sized once per run ([`BlockWork::reset`], in the
+/// buffers of the last run); nothing per iteration.
+#[derive(Debug, Default)]
 pub(crate) struct BlockWork {
     pub(crate) n: usize,
     pub(crate) s: Vec<f64>,
@@ -23,7 +25,9 @@ pub(crate) struct BlockWork {
     pub(crate) product: Vec<f64>,
     pub(crate) correction: Vec<f64>,
     pub(crate) trial: Vec<f64>,
-    pub(crate) supports: Vec<Option<Vec<usize>>>,
+    /// Per coefficient, the rows where it is not zero (empty where the block does not depend
+    /// on the variable: `Block::coefficients[a]` is `None`).
+    pub(crate) supports: Vec<Vec<usize>>,
     /// Per coefficient: more than half its rows non-zero.
     pub(crate) dense: Vec<bool>,
     /// A sparse coefficient's `F_a[S_a, S_a]` (|S_a| × |S_a|).
@@ -36,75 +40,75 @@ pub(crate) struct BlockWork {
     pub(crate) rzr: Vec<f64>,
     pub(crate) rsr: Vec<f64>,
     pub(crate) rqr: Vec<Vec<f64>>,
+    /// Buffers of coefficients beyond this block's count, kept ([`resize_pooled`]).
+    spare: Vec<Vec<f64>>,
+    spare_rows: Vec<Vec<usize>>,
 }
 
 impl BlockWork {
-    pub(crate) fn new(b: &Block) -> BlockWork {
+    /// The state of a run on `b`, in these buffers (no allocation once they have the room).
+    pub(crate) fn reset(&mut self, b: &Block) {
         let n = b.n;
-        let z = || vec![0.0; n * n];
-        let supports: Vec<Option<Vec<usize>>> = b
-            .coefficients
-            .iter()
-            .map(|f| {
-                f.as_ref().map(|f| {
-                    (0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)).collect()
-                })
-            })
-            .collect();
-        let dense: Vec<bool> =
-            supports.iter().map(|s| s.as_ref().is_some_and(|rows| 2 * rows.len() > n)).collect();
-        let sub = b
-            .coefficients
-            .iter()
-            .zip(&supports)
-            .zip(&dense)
-            .map(|((f, rows), dense)| match (f, rows) {
-                (Some(f), Some(rows)) if !dense => {
-                    rows.iter().flat_map(|&r| rows.iter().map(move |&c| f[r * n + c])).collect()
-                }
-                _ => Vec::new(),
-            })
-            .collect();
+        self.n = n;
+        for v in [
+            &mut self.s,
+            &mut self.l,
+            &mut self.s_inv,
+            &mut self.ds,
+            &mut self.dz,
+            &mut self.dz_aff,
+            &mut self.ds_aff,
+            &mut self.t1,
+            &mut self.t2,
+            &mut self.product,
+            &mut self.correction,
+            &mut self.trial,
+        ] {
+            sized(v, n * n);
+        }
+        let count = b.coefficients.len();
+        resize_pooled(&mut self.supports, &mut self.spare_rows, count);
+        self.dense.clear();
+        for (f, rows) in b.coefficients.iter().zip(&mut self.supports) {
+            rows.clear();
+            if let Some(f) = f {
+                rows.extend((0..n).filter(|r| f[r * n..r * n + n].iter().any(|v| *v != 0.0)));
+            }
+            self.dense.push(2 * rows.len() > n);
+        }
+        for v in [&mut self.sub, &mut self.fz, &mut self.sf, &mut self.rqr] {
+            resize_pooled(v, &mut self.spare, count);
+        }
+        for (a, f) in b.coefficients.iter().enumerate() {
+            let sub = &mut self.sub[a];
+            sub.clear();
+            if let Some(f) = f
+                && !self.dense[a]
+            {
+                let rows = &self.supports[a];
+                sub.extend(rows.iter().flat_map(|&r| rows.iter().map(move |&c| f[r * n + c])));
+            }
+        }
         // A factored block (`Block::factors`) uses its factored coefficients' `F_a Z` and
         // `S⁻¹ F_a` nowhere: the products and `R (Z F_a S⁻¹) Rᵀ` only for the others.
         let q = b.factors.as_ref().map_or(0, |f| f.q);
-        let whole = |a: usize| {
-            b.coefficients[a].is_some()
-                && b.factors.as_ref().is_none_or(|f| f.small.get(a).is_none_or(Option::is_none))
-        };
-        let products = |len: usize, only_factored_blocks: bool| {
-            (0..b.coefficients.len())
-                .map(|a| {
-                    let wanted = whole(a) && (!only_factored_blocks || b.factors.is_some());
-                    if wanted { vec![0.0; len] } else { Vec::new() }
-                })
-                .collect::<Vec<_>>()
-        };
-        BlockWork {
-            n,
-            s: z(),
-            l: z(),
-            s_inv: z(),
-            ds: z(),
-            dz: z(),
-            dz_aff: z(),
-            ds_aff: z(),
-            t1: z(),
-            t2: z(),
-            product: z(),
-            correction: z(),
-            trial: z(),
-            fz: products(n * n, false),
-            sf: products(n * n, false),
-            rx: vec![0.0; q * n],
-            rzr: vec![0.0; q * q],
-            rsr: vec![0.0; q * q],
-            rqr: products(q * q, true),
-            supports,
-            dense,
-            sub,
+        for a in 0..count {
+            let whole = b.coefficients[a].is_some()
+                && b.factors.as_ref().is_none_or(|f| f.small.get(a).is_none_or(Option::is_none));
+            sized(&mut self.fz[a], if whole { n * n } else { 0 });
+            sized(&mut self.sf[a], if whole { n * n } else { 0 });
+            sized(&mut self.rqr[a], if whole && b.factors.is_some() { q * q } else { 0 });
         }
+        sized(&mut self.rx, q * n);
+        sized(&mut self.rzr, q * q);
+        sized(&mut self.rsr, q * q);
     }
+}
+
+/// `v` as `len` zeros, in its buffer.
+fn sized(v: &mut Vec<f64>, len: usize) {
+    v.clear();
+    v.resize(len, 0.0);
 }
 
 /// `out = sym(a b c)` (all n × n, `b` and `c` symmetric), `tmp` scratch.
@@ -180,7 +184,8 @@ pub(crate) fn add_block_schur(
     let n = b.n;
     let s_inv = &w.s_inv;
     for (a, fa) in b.coefficients.iter().enumerate() {
-        let (Some(fa), Some(rows)) = (fa, &w.supports[a]) else { continue };
+        let Some(fa) = fa else { continue };
+        let rows = &w.supports[a];
         let (fz, sf) = (&mut w.fz[a], &mut w.sf[a]);
         if w.dense[a] {
             // Mostly dense (a routed arm's A_i): two matrix products.
@@ -197,10 +202,17 @@ pub(crate) fn add_block_schur(
             }
         }
     }
+    let present = |a: usize| b.coefficients.get(a).is_some_and(Option::is_some);
     for a in 0..k {
-        let Some(rows_a) = &w.supports[a] else { continue };
+        if !present(a) {
+            continue;
+        }
+        let rows_a = &w.supports[a];
         for bb in a..k {
-            let Some(rows_b) = &w.supports[bb] else { continue };
+            if !present(bb) {
+                continue;
+            }
+            let rows_b = &w.supports[bb];
             let m = match (w.dense[a], w.dense[bb]) {
                 (_, true) => pair_dense(n, rows_a, &w.sf[bb], &w.fz[a]),
                 (true, false) => pair_dense(n, rows_b, &w.sf[a], &w.fz[bb]),

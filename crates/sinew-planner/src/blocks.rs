@@ -22,14 +22,27 @@ pub(crate) struct Floor {
     pub(crate) k: Matrix3<f64>,
 }
 
+/// The scratch of [`floor_block`], kept between blocks.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    q: Vec<f64>,
+    d: Vec<f64>,
+    b0: Vec<f64>,
+    dense: Vec<f64>,
+    rows: Vec<usize>,
+    mr: Vec<f64>,
+}
+
 /// The base problem: the rows (with `extra` zero columns) and the box, no block.
+#[cfg(test)]
 pub(crate) fn base(f: &Frame, extra: usize) -> Sdp {
     let mut sdp = Sdp::default();
     base_into(f, extra, &mut sdp);
     sdp
 }
 
-/// [`base`] into `sdp`'s buffers (its blocks and epigraph removed).
+/// [`base`]'s problem into `sdp`'s
+/// buffers (its blocks kept as spares for [`push_block`]).
 pub(crate) fn base_into(f: &Frame, extra: usize, sdp: &mut Sdp) {
     let k = f.vars();
     let width = k + extra;
@@ -42,112 +55,145 @@ pub(crate) fn base_into(f: &Frame, extra: usize, sdp: &mut Sdp) {
         sdp.rows.extend(std::iter::repeat_n(0.0, extra));
     }
     sdp.rhs.clone_from(&f.rhs);
-    sdp.blocks.clear();
+    sdp.clear_blocks();
     sdp.lo.clear();
     sdp.lo.extend((0..width).map(|e| if e < k { -1.0 } else { f64::NEG_INFINITY }));
     sdp.hi.clear();
     sdp.hi.extend((0..width).map(|e| if e < k { 1.0 } else { f64::INFINITY }));
-    sdp.epigraph = None;
+}
+
+/// A block filled by `fill` (in an earlier block's buffers) pushed onto `sdp`; its index.
+pub(crate) fn push_block(sdp: &mut Sdp, fill: impl FnOnce(&mut Block)) -> usize {
+    let mut b = sdp.next_block();
+    fill(&mut b);
+    sdp.blocks.push(b);
+    sdp.blocks.len() - 1
 }
 
 /// `(A(x) − shift I)/a_scale`, with `−(t_scale/a_scale) I` for an epigraph variable.
-pub(crate) fn margin_block(f: &Frame, shift: f64, extra: usize, epigraph: Option<f64>) -> Block {
+pub(crate) fn margin_block(
+    f: &Frame,
+    shift: f64,
+    extra: usize,
+    epigraph: Option<f64>,
+    b: &mut Block,
+) {
     let n = f.n;
     let s = 1.0 / f.a_scale;
-    let mut constant: Vec<f64> = f.a0.iter().map(|v| v * s).collect();
-    for i in 0..n {
-        constant[i * n + i] -= shift * s;
+    b.recycle(n, f.vars() + extra);
+    for (c, v) in b.constant.iter_mut().zip(&f.a0) {
+        *c = v * s;
     }
-    let mut coefficients: Vec<Option<Vec<f64>>> =
-        (0..f.vars()).map(|a| Some(f.ai_dense(a, s))).collect();
-    coefficients.extend(std::iter::repeat_n(None, extra));
+    for i in 0..n {
+        b.constant[i * n + i] -= shift * s;
+    }
+    for a in 0..f.vars() {
+        let mut e = b.fresh(n * n);
+        f.add_ai(a, s, &mut e, n);
+        b.coefficients[a] = Some(e);
+    }
     if let Some(t_scale) = epigraph {
-        let mut d = vec![0.0; n * n];
+        let mut d = b.fresh(n * n);
         for i in 0..n {
             d[i * n + i] = -t_scale * s;
         }
-        coefficients[f.vars()] = Some(d);
+        b.coefficients[f.vars()] = Some(d);
     }
-    Block { n, constant, coefficients, factors: None }
 }
 
-/// `Rᵀ(A − τ J_pᵀ K J_p)R / scale`, with `τ` fixed or `τ = t_scale · t`.
+/// `Rᵀ(A − τ J_pᵀ K J_p)R / scale`, with `τ` fixed or `τ = t_scale · t`; `r` the basis `R`
+/// of `null(J_r)` (n × (n − 3)).
 pub(crate) fn floor_block(
     f: &Frame,
-    rotation_null: Option<&Vec<f64>>,
+    r: &[f64],
     floor: Floor,
     tau: Result<f64, f64>,
     extra: usize,
-) -> Option<Block> {
-    let r = rotation_null?;
+    (b, scratch): (&mut Block, &mut Scratch),
+) {
     let (n, p) = (f.n, f.n - 3);
+    let Scratch { q, d, b0, dense, rows, mr } = scratch;
     // Q = J_pᵀ K J_p (n × n).
-    let mut q = vec![0.0; n * n];
+    q.clear();
+    q.resize(n * n, 0.0);
     for a in 0..n {
-        for b in 0..n {
+        for c in 0..n {
             let mut v = 0.0;
             for i in 0..3 {
                 for j in 0..3 {
-                    v += f.j_x[i * n + a] * floor.k[(i, j)] * f.j_x[j * n + b];
+                    v += f.j_x[i * n + a] * floor.k[(i, j)] * f.j_x[j * n + c];
                 }
             }
-            q[a * n + b] = v;
+            q[a * n + c] = v;
         }
     }
-    let d = congruence(&q, r, n, p);
-    let b0 = congruence(&f.a0, r, n, p);
+    for m in [&mut *d, &mut *b0] {
+        m.clear();
+        m.resize(p * p, 0.0);
+    }
+    congruence(q, r, (n, p), (rows, mr), d);
+    congruence(&f.a0, r, (n, p), (rows, mr), b0);
     let scale = (0..p).map(|i| b0[i * p + i].abs()).fold(0.0, f64::max).max(1e-300);
     let s = 1.0 / scale;
     let fixed = tau.unwrap_or(0.0);
-    let constant: Vec<f64> = b0.iter().zip(&d).map(|(b, dd)| (b - fixed * dd) * s).collect();
-    let mut coefficients: Vec<Option<Vec<f64>>> =
-        (0..f.vars()).map(|a| Some(congruence(&f.ai_dense(a, s), r, n, p))).collect();
-    coefficients.extend(std::iter::repeat_n(None, extra));
+    b.recycle(p, f.vars() + extra);
+    for ((c, v), dd) in b.constant.iter_mut().zip(b0.iter()).zip(d.iter()) {
+        *c = (v - fixed * dd) * s;
+    }
+    for a in 0..f.vars() {
+        dense.clear();
+        dense.resize(n * n, 0.0);
+        f.add_ai(a, s, dense, n);
+        let mut e = b.fresh(p * p);
+        congruence(dense, r, (n, p), (rows, mr), &mut e);
+        b.coefficients[a] = Some(e);
+    }
     if let Err(t_scale) = tau {
-        coefficients[f.vars()] = Some(d.iter().map(|v| -t_scale * v * s).collect());
+        let mut e = b.fresh(p * p);
+        for (o, v) in e.iter_mut().zip(d.iter()) {
+            *o = -t_scale * v * s;
+        }
+        b.coefficients[f.vars()] = Some(e);
     }
     // Where every joint's block spans few DOFs (the decoupled model) and the block is above
     // the fixed-size kernels: factored, `B_a = s A_a` over its span. Below, the fixed-size
     // dense products are faster (cdhrm5: 1.54 M instructions a plan dense, 1.95 M factored);
-    // with wide spans among them (routed), the unfactored pairs cost more than before.
+    // with wide spans among them (routed), the unfactored pairs cost more than before. (The
+    // factors are allocated per block: only above the fixed-size kernels.)
     let factored = p > FACTORED_ABOVE && f.spans.iter().all(|s| s.len() <= FACTORED_SPAN);
-    let factors = factored.then(|| Factors {
-        basis: r.clone(),
+    b.factors = factored.then(|| Factors {
+        basis: r.to_vec(),
         q: n,
-        small: (0..coefficients.len())
+        small: (0..b.coefficients.len())
             .map(|a| {
                 f.spans.get(a).map(|span| (span.clone(), f.ai[a].iter().map(|v| v * s).collect()))
             })
             .collect(),
     });
-    Some(Block { n: p, constant, coefficients, factors })
 }
 
 /// `[[A, J_pᵀu], [uᵀJ_p, s]]` congruence-scaled by `diag(a_scale^{-1/2} I, s_scale^{-1/2})`,
 /// `s = s_scale · t`.
-pub(crate) fn compliance_block(f: &Frame, u: &nalgebra::Vector3<f64>, s_scale: f64) -> Block {
+pub(crate) fn compliance_block(f: &Frame, u: &nalgebra::Vector3<f64>, s_scale: f64, b: &mut Block) {
     let n = f.n;
     let m = n + 1;
     let sa = 1.0 / f.a_scale;
     let cross = 1.0 / (f.a_scale * s_scale).sqrt();
-    let mut constant = vec![0.0; m * m];
+    b.recycle(m, f.vars() + 1);
     for r in 0..n {
         for c in 0..n {
-            constant[r * m + c] = f.a0[r * n + c] * sa;
+            b.constant[r * m + c] = f.a0[r * n + c] * sa;
         }
-        let b: f64 = (0..3).map(|i| f.j_x[i * n + r] * u[i]).sum();
-        constant[r * m + n] = b * cross;
-        constant[n * m + r] = b * cross;
+        let v: f64 = (0..3).map(|i| f.j_x[i * n + r] * u[i]).sum();
+        b.constant[r * m + n] = v * cross;
+        b.constant[n * m + r] = v * cross;
     }
-    let mut coefficients: Vec<Option<Vec<f64>>> = (0..f.vars())
-        .map(|a| {
-            let mut e = vec![0.0; m * m];
-            f.add_ai(a, sa, &mut e, m);
-            Some(e)
-        })
-        .collect();
-    let mut d = vec![0.0; m * m];
+    for a in 0..f.vars() {
+        let mut e = b.fresh(m * m);
+        f.add_ai(a, sa, &mut e, m);
+        b.coefficients[a] = Some(e);
+    }
+    let mut d = b.fresh(m * m);
     d[n * m + n] = 1.0;
-    coefficients.push(Some(d));
-    Block { n: m, constant, coefficients, factors: None }
+    b.coefficients[f.vars()] = Some(d);
 }

@@ -12,7 +12,7 @@ use sinew_statics::TensionChoice;
 use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 use sinew_testkit::cdhrm5;
 
-use crate::blocks::{base, margin_block};
+use crate::blocks::{base, margin_block, push_block};
 use crate::frame::Frame;
 use crate::program::{Block, Duals, End, Sdp, Settings, Smooth, bound_at};
 use crate::rows::linear_rows;
@@ -47,7 +47,7 @@ fn stable_points(f: &Frame, margin: f64, count: usize, seed: u64) -> Vec<Vec<f64
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let sdp = {
         let mut s = base(f, 0);
-        s.blocks.push(margin_block(f, margin, 0, None));
+        push_block(&mut s, |b| margin_block(f, margin, 0, None, b));
         s
     };
     let mut out = Vec::new();
@@ -140,7 +140,7 @@ fn random_duals(sdp: &Sdp, rng: &mut ChaCha8Rng) -> Duals {
             z
         })
         .collect();
-    Duals { y, z }
+    Duals { y, z, ..Duals::default() }
 }
 
 #[test]
@@ -149,7 +149,7 @@ fn the_certificate_bounds_every_sampled_feasible_value_for_random_multipliers() 
     for model in cdhrm5::MODELS {
         let f = frame(model);
         let mut sdp = base(&f, 0);
-        sdp.blocks.push(margin_block(&f, 1e-3, 0, None));
+        push_block(&mut sdp, |b| margin_block(&f, 1e-3, 0, None, b));
         let points = stable_points(&f, 1e-3, 400, 3);
         let w = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
         let mut objective = EndObjective::new(&f, Kind::Along(w), 1.0);
@@ -193,6 +193,7 @@ fn the_method_finds_a_hand_solved_optimum_and_certifies_it() {
         constant: vec![1.0, 0.0, 0.0, 1.0],
         coefficients: vec![Some(vec![1.0, 0.0, 0.0, -1.0]), Some(vec![-1.0, 0.0, 0.0, -1.0])],
         factors: None,
+        ..Block::default()
     };
     let sdp = Sdp {
         c0: 0.0,
@@ -203,6 +204,7 @@ fn the_method_finds_a_hand_solved_optimum_and_certifies_it() {
         lo: vec![-1.0, f64::NEG_INFINITY],
         hi: vec![1.0, f64::INFINITY],
         epigraph: Some((1, 0)),
+        ..Sdp::default()
     };
     let settings = Settings {
         relative_gap: 1e-10,
@@ -211,9 +213,10 @@ fn the_method_finds_a_hand_solved_optimum_and_certifies_it() {
         target: None,
         centring: 0.0,
     };
-    let run = sdp::solve(&sdp, None, &[0.7, -2.0], settings);
+    let mut work = sdp::SolveWork::default();
+    let run = sdp::solve(&sdp, None, &[0.7, -2.0], settings, &mut work);
     assert_eq!(run.end, End::Optimum);
-    assert!((run.x[0]).abs() <= 1e-8 && (run.value - 1.0).abs() <= 1e-9, "{:?}", run.x);
+    assert!((work.x[0]).abs() <= 1e-8 && (run.value - 1.0).abs() <= 1e-9, "{:?}", work.x);
     assert!(run.upper >= 1.0 - 1e-12 && run.upper - run.value <= 1e-10);
 }
 
@@ -286,7 +289,7 @@ fn a_refilled_pencil_is_a_fresh_one() {
 #[test]
 fn a_floors_factored_schur_terms_are_its_dense_ones() {
     use crate::block_work::{BlockWork, add_block_schur};
-    use crate::blocks::{Floor, floor_block};
+    use crate::blocks::{Floor, Scratch, floor_block};
     // A 12-joint weightless chain under a small tip force: 24 DOFs, a 21 × 21 floor, above
     // the fixed-size kernels (below them the floor is not factored).
     let (robot, routing) = cdhrm5::chain(12, PatternModel::Decoupled);
@@ -299,7 +302,8 @@ fn a_floors_factored_schur_terms_are_its_dense_ones() {
     let x = stable_points(&f, 0.0, 1, 5).remove(0);
     let k = nalgebra::Matrix3::new(2.0, 0.3, 0.1, 0.3, 1.0, 0.2, 0.1, 0.2, 1.5);
     for tau in [Ok(0.5), Err(2.0)] {
-        let factored = floor_block(&f, Some(&r), Floor { k }, tau, 1).unwrap();
+        let mut factored = Block::default();
+        floor_block(&f, &r, Floor { k }, tau, 1, (&mut factored, &mut Scratch::default()));
         assert!(factored.factors.as_ref().unwrap().small[..f.vars()].iter().all(Option::is_some));
         let dense = Block { factors: None, ..factored.clone() };
         let n = factored.n;
@@ -309,7 +313,8 @@ fn a_floors_factored_schur_terms_are_its_dense_ones() {
         let z_m = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
         let z: Vec<f64> = (0..n * n).map(|e| z_m[(e / n, e % n)]).collect();
         let schur = |block: &Block| {
-            let mut w = BlockWork::new(block);
+            let mut w = BlockWork::default();
+            w.reset(block);
             let mut s = vec![0.0; n * n];
             block.at(&xs, &mut s);
             let s_m = DMatrix::from_fn(n, n, |i, j| s[i * n + j]);

@@ -275,6 +275,7 @@ impl Frame {
     }
 
     /// `scale · ∂A/∂x_a`, n × n row-major.
+    #[cfg(test)]
     pub(crate) fn ai_dense(&self, a: usize, scale: f64) -> Vec<f64> {
         let mut out = vec![0.0; self.n * self.n];
         self.add_ai(a, scale, &mut out, self.n);
@@ -305,15 +306,30 @@ impl Frame {
 
     /// `R`: an orthonormal basis of `null(J_r)` (n × (n − 3), row-major), by Gram–Schmidt
     /// twice on the rotation rows and then the unit vectors; `None` when `J_r` has rank < 3.
+    #[cfg(test)]
     pub(crate) fn rotation_null_basis(&self) -> Option<Vec<f64>> {
+        let (mut basis, mut out) = (Vec::new(), Vec::new());
+        self.rotation_null_basis_into(&mut basis, &mut out).then_some(out)
+    }
+
+    /// [`Self::rotation_null_basis`] into `out`, `basis` scratch (both reused): whether there
+    /// is one.
+    pub(crate) fn rotation_null_basis_into(
+        &self,
+        basis: &mut Vec<f64>,
+        out: &mut Vec<f64>,
+    ) -> bool {
         let n = self.n;
+        out.clear();
         if n < 6 {
-            return None;
+            return false;
         }
-        let mut basis: Vec<Vec<f64>> = Vec::with_capacity(n);
-        let orthogonalise = |v: &mut Vec<f64>, basis: &[Vec<f64>]| {
+        // The orthonormal vectors so far, one after another (n each); the candidate after them.
+        basis.clear();
+        let orthogonalise = |basis: &mut [f64], count: usize| {
+            let (done, v) = basis.split_at_mut(count * n);
             for _ in 0..2 {
-                for b in basis {
+                for b in done.chunks_exact(n) {
                     let d: f64 = v.iter().zip(b).map(|(a, c)| a * c).sum();
                     for (x, y) in v.iter_mut().zip(b) {
                         *x -= d * y;
@@ -321,49 +337,69 @@ impl Frame {
                 }
             }
         };
-        for r in 3..6 {
-            let mut v = self.j_x[r * n..r * n + n].to_vec();
-            let scale = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            orthogonalise(&mut v, &basis);
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if !(norm > 1e-9 * scale && norm.is_finite()) {
-                return None;
+        let normalise = |basis: &mut [f64], count: usize, norm: f64| {
+            for x in &mut basis[count * n..] {
+                *x /= norm;
             }
-            basis.push(v.iter().map(|x| x / norm).collect());
+        };
+        let norm_of = |basis: &[f64], count: usize| {
+            basis[count * n..].iter().map(|x| x * x).sum::<f64>().sqrt()
+        };
+        for r in 3..6 {
+            let count = r - 3;
+            basis.extend_from_slice(&self.j_x[r * n..r * n + n]);
+            let scale = norm_of(basis, count);
+            orthogonalise(basis, count);
+            let norm = norm_of(basis, count);
+            if !(norm > 1e-9 * scale && norm.is_finite()) {
+                return false;
+            }
+            normalise(basis, count, norm);
         }
-        let mut out = Vec::with_capacity(n * (n - 3));
-        let mut columns = 0;
+        let mut count = 3;
         for e in 0..n {
-            if columns == n - 3 {
+            if count == n {
                 break;
             }
-            let mut v = vec![0.0; n];
-            v[e] = 1.0;
-            orthogonalise(&mut v, &basis);
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            basis.extend(std::iter::repeat_n(0.0, n));
+            basis[count * n + e] = 1.0;
+            orthogonalise(basis, count);
+            let norm = norm_of(basis, count);
             if norm > 0.3 {
-                let v: Vec<f64> = v.iter().map(|x| x / norm).collect();
-                basis.push(v);
-                columns += 1;
+                normalise(basis, count, norm);
+                count += 1;
+            } else {
+                basis.truncate(count * n);
             }
         }
         // Row-major n × (n − 3): R[r, c] = basis[3 + c][r].
+        if count != n {
+            return false;
+        }
         for r in 0..n {
             for c in 0..n - 3 {
-                out.push(basis[3 + c][r]);
+                out.push(basis[(3 + c) * n + r]);
             }
         }
-        (columns == n - 3).then_some(out)
+        true
     }
 }
 
-/// `Rᵀ M R` (M n × n symmetric, R n × p, both row-major) into a new p × p matrix, over the rows
-/// of `M` that are not zero only (a decoupled `A_i` has two): `Σ_{i ∈ S} R_iᵀ (M R)_i`.
-pub(crate) fn congruence(m: &[f64], r: &[f64], n: usize, p: usize) -> Vec<f64> {
-    let rows: Vec<usize> =
-        (0..n).filter(|&i| m[i * n..i * n + n].iter().any(|v| *v != 0.0)).collect();
-    let mut mr = vec![0.0; n * p];
-    for &i in &rows {
+/// `Rᵀ M R` (M n × n symmetric, R n × p, both row-major) into `out` (p × p), over the rows
+/// of `M` that are not zero only (a decoupled `A_i` has two): `Σ_{i ∈ S} R_iᵀ (M R)_i`. `rows`
+/// and `mr` are scratch, reused.
+pub(crate) fn congruence(
+    m: &[f64],
+    r: &[f64],
+    (n, p): (usize, usize),
+    (rows, mr): (&mut Vec<usize>, &mut Vec<f64>),
+    out: &mut [f64],
+) {
+    rows.clear();
+    rows.extend((0..n).filter(|&i| m[i * n..i * n + n].iter().any(|v| *v != 0.0)));
+    mr.clear();
+    mr.resize(n * p, 0.0);
+    for &i in rows.iter() {
         for k in 0..n {
             let v = m[i * n + k];
             if v == 0.0 {
@@ -372,8 +408,8 @@ pub(crate) fn congruence(m: &[f64], r: &[f64], n: usize, p: usize) -> Vec<f64> {
             crate::dense::axpy(v, &r[k * p..k * p + p], &mut mr[i * p..i * p + p]);
         }
     }
-    let mut out = vec![0.0; p * p];
-    for &i in &rows {
+    out.fill(0.0);
+    for &i in rows.iter() {
         for a in 0..p {
             let ra = r[i * p + a];
             if ra == 0.0 {
@@ -382,6 +418,5 @@ pub(crate) fn congruence(m: &[f64], r: &[f64], n: usize, p: usize) -> Vec<f64> {
             crate::dense::axpy(ra, &mr[i * p..i * p + p], &mut out[a * p..a * p + p]);
         }
     }
-    crate::dense::symmetrise(&mut out, p);
-    out
+    crate::dense::symmetrise(out, p);
 }

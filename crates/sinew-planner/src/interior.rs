@@ -5,13 +5,14 @@
 use crate::active;
 use crate::error::PlanError;
 use crate::frame::Frame;
-use crate::ipm::{Answer, Interior};
+use crate::ipm::{Answer, Interior, Last};
 use crate::problem::{Objective, PlanSettings, Requirements};
 
 /// The most iterations a warm start may take before the step runs cold.
 pub(crate) const WARM_ITERATIONS: usize = 12;
 
-/// The cold method: the answer and the iterations of the phases before the last.
+/// The cold method: the answer (its `x` in the buffer `work.x`, moved) and the iterations of
+/// the phases before the last, in `work`'s buffers.
 ///
 /// # Errors
 /// The phases' ([`Interior`]).
@@ -20,13 +21,22 @@ pub(crate) fn cold(
     objective: Objective,
     requirements: &Requirements,
     settings: &PlanSettings,
+    work: &mut active::WarmWork,
 ) -> Result<(Answer, usize), PlanError> {
-    let problem = Interior::new(frame, objective, requirements, settings);
-    let (x, rows) = problem.inside_rows()?;
-    let (x, stable) = problem.stable(x)?;
-    let (x, floors) = problem.floors_met(x)?;
-    let answer = problem.optimise(&x, settings.max_iterations)?;
-    Ok((answer, rows + stable + floors))
+    let w = &mut work.ipm;
+    let problem = Interior::new(frame, objective, requirements, settings, w);
+    let rows = problem.inside_rows(w)?;
+    let stable = problem.stable(w)?;
+    let floors = problem.floors_met(w)?;
+    let last = problem.optimise(w, settings.max_iterations)?;
+    Ok((answer(work, last), rows + stable + floors))
+}
+
+/// The answer of the last phase, its `x` moved out of `work.x` (refilled from the phases').
+fn answer(work: &mut active::WarmWork, last: Last) -> Answer {
+    let mut x = std::mem::take(&mut work.x);
+    x.clone_from(&work.ipm.x);
+    Answer { x, upper: last.upper, iterations: last.iterations }
 }
 
 /// Newton steps on the mapped previous answer's active set ([`active::warm`]); where they do
@@ -51,11 +61,19 @@ pub(crate) fn warm(
         }
         Err(steps) => steps,
     };
-    let mut problem = Interior::new(frame, objective, requirements, settings);
+    let w = &mut work.ipm;
+    let mut problem = Interior::new(frame, objective, requirements, settings, w);
     problem.warm = true;
-    let x = problem.restored(x).ok_or(tried)?;
-    match problem.optimise(&x, WARM_ITERATIONS) {
-        Ok(answer) => Ok(Answer { iterations: answer.iterations + tried, ..answer }),
+    let restored = problem.restored(&x, w);
+    work.mapped = x;
+    if !restored {
+        return Err(tried);
+    }
+    match problem.optimise(&mut work.ipm, WARM_ITERATIONS) {
+        Ok(last) => {
+            let answer = answer(work, last);
+            Ok(Answer { iterations: answer.iterations + tried, ..answer })
+        }
         Err(PlanError::NotConverged { iterations, .. }) => Err(iterations + tried),
         Err(_) => Err(WARM_ITERATIONS + tried),
     }

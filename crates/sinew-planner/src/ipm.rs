@@ -14,11 +14,12 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector6};
 
-use crate::blocks::{Floor, base, compliance_block, floor_block, margin_block};
+use crate::blocks::{Floor, base_into, compliance_block, floor_block, margin_block, push_block};
 use crate::error::PlanError;
 use crate::frame::Frame;
+use crate::ipm_work::{IpmWork, compliance_at, floor_value, k_x_at, margin_exceeds};
 use crate::problem::{Objective, PlanSettings, Requirements};
-use crate::sdp::{self, Block, End, Run, Settings};
+use crate::sdp::{self, End, Run, Settings};
 use crate::smooth::{EndObjective, Kind};
 
 /// How far past its target a feasibility phase goes, as a fraction of the bound's excess: a
@@ -29,15 +30,16 @@ const CENTRING: f64 = 0.3;
 /// it, the fixed-size kernels make the margin's block cheap.
 pub(crate) const LAZY_MARGIN_DOF: usize = 16;
 
-/// One plan's interior-point problem.
+/// One plan's interior-point problem. Its phases run in an [`IpmWork`] and pass their point on
+/// in its `x`.
 pub(crate) struct Interior<'a> {
     pub(crate) frame: &'a Frame,
     pub(crate) objective: Objective,
     pub(crate) requirements: &'a Requirements,
     pub(crate) settings: &'a PlanSettings,
-    /// `R` (n × (n − 3)), when `J_r` has rank 3 and a floor block needs it (`None` when
-    /// none does).
-    pub(crate) rotation_null: Option<Vec<f64>>,
+    /// Whether the work's `rotation_null` holds `R` (n × (n − 3)): when `J_r` has rank 3 and a
+    /// floor block needs it.
+    pub(crate) rotation_null: bool,
     /// A warm start: epigraph variables start just inside their block, not halfway.
     pub(crate) warm: bool,
 }
@@ -51,23 +53,45 @@ pub(crate) struct Answer {
     pub(crate) iterations: usize,
 }
 
+/// The last phase's end: its point is the work's `x`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Last {
+    /// As [`Answer::upper`].
+    pub(crate) upper: f64,
+    pub(crate) iterations: usize,
+}
+
+/// The run's last iterate less its epigraph variable (the first `k`) into the work's `x`.
+fn take_point(w: &mut IpmWork, k: usize) {
+    w.x.clear();
+    w.x.extend_from_slice(&w.run.x[..k]);
+}
+
+/// The work's `x` with an epigraph variable `t` into its `start`.
+fn start_with(w: &mut IpmWork, t: f64) {
+    w.start.clone_from(&w.x);
+    w.start.push(t);
+}
+
 impl<'a> Interior<'a> {
     pub(crate) fn new(
         frame: &'a Frame,
         objective: Objective,
         requirements: &'a Requirements,
         settings: &'a PlanSettings,
+        w: &mut IpmWork,
     ) -> Interior<'a> {
+        let floors = matches!(objective, Objective::MinStiffness)
+            || requirements.k_min.is_some()
+            || requirements.k_des.is_some();
+        w.rotation_null.clear();
         Interior {
             frame,
             objective,
             requirements,
             settings,
-            rotation_null: (matches!(objective, Objective::MinStiffness)
-                || requirements.k_min.is_some()
-                || requirements.k_des.is_some())
-            .then(|| frame.rotation_null_basis())
-            .flatten(),
+            rotation_null: floors
+                && frame.rotation_null_basis_into(&mut w.basis, &mut w.rotation_null),
             warm: false,
         }
     }
@@ -80,28 +104,13 @@ impl<'a> Interior<'a> {
         }
     }
 
-    /// `λ_min(A(x))`, N m/rad (one symmetric eigensolve, outside the iterations).
+    /// `λ_min(A(x))`, N m/rad (one symmetric eigensolve, outside the iterations, where a
+    /// phase 1 is needed).
     pub(crate) fn margin_at(&self, x: &[f64]) -> f64 {
         let n = self.frame.n;
         let mut a = vec![0.0; n * n];
         self.frame.a_at(x, &mut a);
         DMatrix::from_row_slice(n, n, &a).symmetric_eigenvalues().min()
-    }
-
-    /// Whether `λ_min(A(x)) > m`: one Cholesky trial of `A(x) − m I`.
-    fn margin_exceeds(&self, x: &[f64], m: f64) -> bool {
-        let n = self.frame.n;
-        let mut a = vec![0.0; n * n];
-        self.frame.a_at(x, &mut a);
-        for i in 0..n {
-            a[i * n + i] -= m;
-        }
-        crate::dense::cholesky(&mut a, n)
-    }
-
-    /// `K_x` at `x` (`None` where `A ⊁ 0` or `J_x` has rank < 6).
-    fn k_x_at(&self, x: &[f64]) -> Option<nalgebra::Matrix6<f64>> {
-        EndObjective::end_only(self.frame).end_at(x).map(|e| e.k_x)
     }
 
     fn settings(&self, target: Option<f64>, relative_gap: f64, scale: f64) -> Settings {
@@ -114,20 +123,23 @@ impl<'a> Interior<'a> {
         }
     }
 
-    /// Phase 0: a point strictly inside the rows, near their Chebyshev centre.
+    /// Phase 0: a point strictly inside the rows, near their Chebyshev centre, into `w.x`;
+    /// the iterations.
     ///
     /// # Errors
     /// [`PlanError::BudgetsInfeasible`] when no point meets the rows.
-    pub(crate) fn inside_rows(&self) -> Result<(Vec<f64>, usize), PlanError> {
+    pub(crate) fn inside_rows(&self, w: &mut IpmWork) -> Result<usize, PlanError> {
         let f = self.frame;
         let k = f.vars();
-        let x0 = vec![0.0; k];
+        w.x.clear();
+        w.x.resize(k, 0.0);
         let least = f.rhs.iter().copied().fold(f64::INFINITY, f64::min);
         if least > 1e-3 || f.rhs.is_empty() {
-            return Ok((x0, 0));
+            return Ok(0);
         }
         // max τ s.t. G x + τ 1 ≤ h, τ ≤ 1; τ's box [τ₀ − 1, 1] holds the optimum.
-        let mut sdp = base(self.frame, 1);
+        let sdp = &mut w.sdp;
+        base_into(f, 1, sdp);
         for r in 0..f.rhs.len() {
             sdp.rows[r * (k + 1) + k] = 1.0;
         }
@@ -138,49 +150,47 @@ impl<'a> Interior<'a> {
         sdp.c[k] = 1.0;
         sdp.lo[k] = tau0 - 1.0;
         sdp.hi[k] = 1.0;
-        let mut start = x0;
-        start.push(tau0);
+        start_with(w, tau0);
         // Until τ > 0 well inside (or the bound proves τ* ≤ 0: no point strictly inside).
-        let run = sdp::solve(&sdp, None, &start, self.settings(Some(0.0), 1e-9, 1e-9));
+        let settings = self.settings(Some(0.0), 1e-9, 1e-9);
+        let run = sdp::solve(&w.sdp, None, &w.start, settings, &mut w.run);
         match run.end {
             End::Reached => {
-                let mut x = run.x;
-                x.pop();
-                Ok((x, run.iterations))
+                take_point(w, k);
+                Ok(run.iterations)
             }
             End::Unreachable | End::Optimum => Err(PlanError::BudgetsInfeasible),
             _ => Err(not_converged(&run, 1e-9)),
         }
     }
 
-    /// Phase 1: from `x` inside the rows, a point with margin ≥ the requirement.
+    /// Phase 1: from `w.x` inside the rows, a point with margin ≥ the requirement.
     ///
     /// # Errors
     /// [`PlanError::NoStableTensions`] with the certified bound of the best margin.
-    pub(crate) fn stable(&self, x: Vec<f64>) -> Result<(Vec<f64>, usize), PlanError> {
+    pub(crate) fn stable(&self, w: &mut IpmWork) -> Result<usize, PlanError> {
         let f = self.frame;
         let m = self.requirements.margin;
-        if self.margin_exceeds(&x, m) {
-            return Ok((x, 0));
+        if margin_exceeds(f, &w.x, m, &mut w.a) {
+            return Ok(0);
         }
-        let now = self.margin_at(&x);
+        let now = self.margin_at(&w.x);
         if now > m {
-            return Ok((x, 0));
+            return Ok(0);
         }
         let k = f.vars();
-        let mut sdp = base(self.frame, 1);
-        sdp.blocks.push(margin_block(self.frame, 0.0, 1, Some(f.a_scale)));
-        sdp.c[k] = 1.0;
-        sdp.epigraph = Some((k, 0));
-        let mut start = x;
-        start.push((now - 0.05 * f.a_scale.max(now.abs())) / f.a_scale);
+        base_into(f, 1, &mut w.sdp);
+        push_block(&mut w.sdp, |b| margin_block(f, 0.0, 1, Some(f.a_scale), b));
+        w.sdp.c[k] = 1.0;
+        w.sdp.epigraph = Some((k, 0));
+        start_with(w, (now - 0.05 * f.a_scale.max(now.abs())) / f.a_scale);
         let target = (m + 1e-9 * m.max(f.a_scale * 1e-6)) / f.a_scale;
-        let run = sdp::solve(&sdp, None, &start, self.settings(Some(target), 1e-9, 1e-9));
+        let settings = self.settings(Some(target), 1e-9, 1e-9);
+        let run = sdp::solve(&w.sdp, None, &w.start, settings, &mut w.run);
         match run.end {
             End::Reached => {
-                let mut x = run.x;
-                x.pop();
-                Ok((x, run.iterations))
+                take_point(w, k);
+                Ok(run.iterations)
             }
             End::Unreachable | End::Optimum => Err(self.no_stable_tensions(run.upper * f.a_scale)),
             _ => Err(not_converged(&run, 1e-9)),
@@ -188,79 +198,80 @@ impl<'a> Interior<'a> {
     }
 
     /// The floors of the requirements, in order (`k_min`, then `K_des`): `(K, τ)`.
-    pub(crate) fn floors(&self) -> Vec<(Floor, f64, &'static str)> {
-        let mut out = Vec::new();
-        if let Some(k) = self.requirements.k_min {
-            out.push((Floor { k: Matrix3::identity() }, k, "least stiffness λ_min(K_fd), N/m,"));
+    pub(crate) fn floors(&self) -> [Option<(Floor, f64, &'static str)>; 2] {
+        let r = self.requirements;
+        [
+            r.k_min.map(|k| {
+                (Floor { k: Matrix3::identity() }, k, "least stiffness λ_min(K_fd), N/m,")
+            }),
+            r.k_des.map(|k| (Floor { k }, 1.0, "K_fd ⪰ τ K_des, τ")),
+        ]
+    }
+
+    /// A floor block `K_fd ⪰ τ K` pushed onto the work's problem.
+    ///
+    /// # Errors
+    /// [`PlanError::NoEndStiffness`] when `J_r` has rank < 3 (no `R`).
+    fn push_floor(
+        &self,
+        w: &mut IpmWork,
+        floor: Floor,
+        tau: Result<f64, f64>,
+        extra: usize,
+    ) -> Result<usize, PlanError> {
+        if !self.rotation_null {
+            return Err(PlanError::NoEndStiffness);
         }
-        if let Some(k) = self.requirements.k_des {
-            out.push((Floor { k }, 1.0, "K_fd ⪰ τ K_des, τ"));
-        }
-        out
+        let (f, r, scratch) = (self.frame, &w.rotation_null, &mut w.scratch);
+        Ok(push_block(&mut w.sdp, |b| floor_block(f, r, floor, tau, extra, (b, scratch))))
     }
 
     /// The margin (unless `lazy`) and the floors met so far as fixed blocks, with `extra`
-    /// columns.
+    /// columns, pushed onto the work's problem.
     fn constraint_blocks(
         &self,
+        w: &mut IpmWork,
         floors: usize,
         extra: usize,
         lazy: bool,
-    ) -> Result<Vec<Block>, PlanError> {
-        let mut blocks = Vec::new();
+    ) -> Result<(), PlanError> {
         if !lazy {
-            blocks.push(margin_block(self.frame, self.requirements.margin, extra, None));
+            let (f, m) = (self.frame, self.requirements.margin);
+            push_block(&mut w.sdp, |b| margin_block(f, m, extra, None, b));
         }
-        for (floor, tau, _) in self.floors().into_iter().take(floors) {
-            blocks.push(
-                floor_block(self.frame, self.rotation_null.as_ref(), floor, Ok(tau), extra)
-                    .ok_or(PlanError::NoEndStiffness)?,
-            );
+        for (floor, tau, _) in self.floors().into_iter().flatten().take(floors) {
+            self.push_floor(w, floor, Ok(tau), extra)?;
         }
-        Ok(blocks)
+        Ok(())
     }
 
-    /// The least `τ` with `K_fd ⪰ τ K` at `x` (the generalised eigenvalue).
-    pub(crate) fn floor_value(&self, x: &[f64], floor: &Floor) -> Option<f64> {
-        let k_fd = self.k_x_at(x)?.fixed_view::<3, 3>(0, 0).into_owned();
-        let l = floor.k.cholesky()?.l();
-        let l_inv = l.try_inverse()?;
-        let m = l_inv * k_fd * l_inv.transpose();
-        Some(nalgebra::SymmetricEigen::new(0.5 * (m + m.transpose())).eigenvalues.min())
-    }
-
-    /// Phase 1b: from a stable `x`, a point meeting every stiffness floor.
+    /// Phase 1b: from a stable `w.x`, a point meeting every stiffness floor.
     ///
     /// # Errors
     /// [`PlanError::RequirementUnreachable`] with the certified bound;
     /// [`PlanError::NoEndStiffness`] when `K_x` does not exist.
-    pub(crate) fn floors_met(&self, mut x: Vec<f64>) -> Result<(Vec<f64>, usize), PlanError> {
+    pub(crate) fn floors_met(&self, w: &mut IpmWork) -> Result<usize, PlanError> {
         let mut iterations = 0;
-        let k = self.frame.vars();
-        for (index, (floor, tau, what)) in self.floors().into_iter().enumerate() {
-            let now = self.floor_value(&x, &floor).ok_or(PlanError::NoEndStiffness)?;
+        let f = self.frame;
+        let k = f.vars();
+        for (index, (floor, tau, what)) in self.floors().into_iter().flatten().enumerate() {
+            let now = floor_value(f, &w.x, &floor, &mut w.end).ok_or(PlanError::NoEndStiffness)?;
             if now > tau {
                 continue;
             }
             let scale = now.abs().max(tau.abs()).max(1e-12);
-            let mut sdp = base(self.frame, 1);
-            sdp.blocks = self.constraint_blocks(index, 1, false)?;
-            let epigraph =
-                floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
-                    .ok_or(PlanError::NoEndStiffness)?;
-            sdp.blocks.push(epigraph);
-            sdp.c[k] = 1.0;
-            sdp.epigraph = Some((k, sdp.blocks.len() - 1));
-            let mut start = x.clone();
-            start.push((now - 0.05 * scale) / scale);
+            base_into(f, 1, &mut w.sdp);
+            self.constraint_blocks(w, index, 1, false)?;
+            let epigraph = self.push_floor(w, floor, Err(scale), 1)?;
+            w.sdp.c[k] = 1.0;
+            w.sdp.epigraph = Some((k, epigraph));
+            start_with(w, (now - 0.05 * scale) / scale);
             let target = (tau + 1e-9 * scale) / scale;
-            let run = sdp::solve(&sdp, None, &start, self.settings(Some(target), 1e-9, 1e-9));
+            let settings = self.settings(Some(target), 1e-9, 1e-9);
+            let run = sdp::solve(&w.sdp, None, &w.start, settings, &mut w.run);
             iterations += run.iterations;
             match run.end {
-                End::Reached => {
-                    x = run.x;
-                    x.pop();
-                }
+                End::Reached => take_point(w, k),
                 End::Unreachable | End::Optimum => {
                     return Err(PlanError::RequirementUnreachable {
                         what,
@@ -271,11 +282,12 @@ impl<'a> Interior<'a> {
                 _ => return Err(not_converged(&run, 1e-9)),
             }
         }
-        Ok((x, iterations))
+        Ok(iterations)
     }
 
-    /// The last phase: the objective from `x` meeting every requirement. The returned bound is
-    /// in real units of the maximised objective (`−Σ f`, `−uᵀ C u` for the minimised ones).
+    /// The last phase: the objective from `w.x` meeting every requirement, its answer into
+    /// `w.x`. The returned bound is in real units of the maximised objective (`−Σ f`,
+    /// `−uᵀ C u` for the minimised ones).
     ///
     /// Above [`LAZY_MARGIN_DOF`] DOFs the margin is checked lazily, as the margin rarely binds
     /// where the objective asks for stiffness and its n × n block dominates an iteration: the
@@ -287,54 +299,62 @@ impl<'a> Interior<'a> {
     ///
     /// # Errors
     /// [`PlanError::NoEndStiffness`]; [`PlanError::NotConverged`].
-    pub(crate) fn optimise(&self, x: &[f64], max_iterations: usize) -> Result<Answer, PlanError> {
+    pub(crate) fn optimise(
+        &self,
+        w: &mut IpmWork,
+        max_iterations: usize,
+    ) -> Result<Last, PlanError> {
         if self.frame.n <= LAZY_MARGIN_DOF {
-            return self.optimise_blocks(x, max_iterations, false);
+            return self.optimise_blocks(w, max_iterations, false);
         }
-        let spent = match self.optimise_blocks(x, max_iterations, true) {
-            Ok(answer) if self.margin_exceeds(&answer.x, self.requirements.margin) => {
-                return Ok(answer);
+        w.from.clone_from(&w.x);
+        let spent = match self.optimise_blocks(w, max_iterations, true) {
+            Ok(last) if margin_exceeds(self.frame, &w.x, self.requirements.margin, &mut w.a) => {
+                return Ok(last);
             }
-            Ok(answer) => answer.iterations,
+            Ok(last) => last.iterations,
             Err(PlanError::NotConverged { iterations, .. }) => iterations,
             Err(PlanError::NoEndStiffness) => 0,
             Err(other) => return Err(other),
         };
-        let answer = self.optimise_blocks(x, max_iterations, false)?;
-        Ok(Answer { iterations: answer.iterations + spent, ..answer })
+        w.x.clone_from(&w.from);
+        let last = self.optimise_blocks(w, max_iterations, false)?;
+        Ok(Last { iterations: last.iterations + spent, ..last })
     }
 
     /// [`Self::optimise`]'s run, with the margin's block unless `lazy`.
     fn optimise_blocks(
         &self,
-        x: &[f64],
+        w: &mut IpmWork,
         max_iterations: usize,
         lazy: bool,
-    ) -> Result<Answer, PlanError> {
+    ) -> Result<Last, PlanError> {
         let f = self.frame;
         let k = f.vars();
         let gap = self.settings.relative_gap;
         let mut settings = self.settings(None, gap, 1e-9);
         settings.max_iterations = max_iterations;
-        let floors = self.floors().len();
+        let floors = self.floors().into_iter().flatten().count();
         let (run, scale) = match self.objective {
             Objective::LeastTension => {
-                let mut sdp = base(self.frame, 0);
-                sdp.blocks = self.constraint_blocks(floors, 0, lazy)?;
-                let total = f.total + f.sums.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                base_into(f, 0, &mut w.sdp);
+                self.constraint_blocks(w, floors, 0, lazy)?;
+                let total = f.total + f.sums.iter().zip(&w.x).map(|(a, b)| a * b).sum::<f64>();
                 let scale = total.abs().max(1e-9);
-                sdp.c0 = -f.total / scale;
-                sdp.c = f.sums.iter().map(|s| -s / scale).collect();
-                (sdp::solve(&sdp, None, x, settings), scale)
+                w.sdp.c0 = -f.total / scale;
+                for (c, s) in w.sdp.c.iter_mut().zip(&f.sums) {
+                    *c = -s / scale;
+                }
+                (sdp::solve(&w.sdp, None, &w.x, settings, &mut w.run), scale)
             }
             Objective::StiffnessAlong(_) | Objective::Volume => {
-                let mut sdp = base(self.frame, 0);
-                sdp.blocks = self.constraint_blocks(floors, 0, lazy)?;
-                let k_x = self.k_x_at(x).ok_or(PlanError::NoEndStiffness)?;
+                base_into(f, 0, &mut w.sdp);
+                self.constraint_blocks(w, floors, 0, lazy)?;
+                let k_x = k_x_at(f, &w.x, &mut w.end).ok_or(PlanError::NoEndStiffness)?;
                 let (kind, now) = match self.objective {
                     Objective::StiffnessAlong(u) => {
-                        let w = Vector6::new(u.x, u.y, u.z, 0., 0., 0.);
-                        (Kind::Along(w), w.dot(&(k_x * w)))
+                        let v = Vector6::new(u.x, u.y, u.z, 0., 0., 0.);
+                        (Kind::Along(v), v.dot(&(k_x * v)))
                     }
                     _ => (Kind::Volume, k_x.fixed_view::<3, 3>(0, 0).determinant().ln()),
                 };
@@ -346,62 +366,46 @@ impl<'a> Interior<'a> {
                     // The gap's absolute floor: 1 in log units.
                     settings.scale = 1.0 / scale;
                 }
-                let mut smooth = EndObjective::new(f, kind, scale);
-                (sdp::solve(&sdp, Some(&mut smooth), x, settings), scale)
+                let buffers = std::mem::take(&mut w.end);
+                let mut smooth = EndObjective::reusing(f, kind, scale, buffers);
+                let run = sdp::solve(&w.sdp, Some(&mut smooth), &w.x, settings, &mut w.run);
+                w.end = smooth.into_buffers();
+                (run, scale)
             }
             Objective::MinStiffness => {
                 let floor = Floor { k: Matrix3::identity() };
-                let now = self.floor_value(x, &floor).ok_or(PlanError::NoEndStiffness)?;
+                let now =
+                    floor_value(f, &w.x, &floor, &mut w.end).ok_or(PlanError::NoEndStiffness)?;
                 let scale = now.abs().max(1e-12);
-                let mut sdp = base(self.frame, 1);
-                sdp.blocks = self.constraint_blocks(floors, 1, lazy)?;
-                sdp.blocks.push(
-                    floor_block(self.frame, self.rotation_null.as_ref(), floor, Err(scale), 1)
-                        .ok_or(PlanError::NoEndStiffness)?,
+                base_into(f, 1, &mut w.sdp);
+                self.constraint_blocks(w, floors, 1, lazy)?;
+                let epigraph = self.push_floor(w, floor, Err(scale), 1)?;
+                w.sdp.c[k] = 1.0;
+                w.sdp.epigraph = Some((k, epigraph));
+                start_with(
+                    w,
+                    if self.warm { (1.0 - 1e-3) * now / scale } else { 0.5 * now / scale },
                 );
-                sdp.c[k] = 1.0;
-                sdp.epigraph = Some((k, sdp.blocks.len() - 1));
-                let mut start = x.to_vec();
-                start.push(if self.warm { (1.0 - 1e-3) * now / scale } else { 0.5 * now / scale });
-                let run = sdp::solve(&sdp, None, &start, settings);
-                (run, scale)
+                (sdp::solve(&w.sdp, None, &w.start, settings, &mut w.run), scale)
             }
             Objective::ComplianceAlong(u) => {
-                let c = self
-                    .compliance_at(x, &u)
+                let c = compliance_at(f, &w.x, &u, (&mut w.a, &mut w.b, &mut w.z))
                     .ok_or_else(|| self.no_stable_tensions(f64::NEG_INFINITY))?;
                 let scale = c.abs().max(1e-300);
-                let mut sdp = base(self.frame, 1);
-                sdp.blocks = self.constraint_blocks(floors, 1, lazy)?;
-                sdp.blocks.push(compliance_block(self.frame, &u, scale));
-                sdp.c[k] = -1.0;
-                sdp.epigraph = Some((k, sdp.blocks.len() - 1));
-                let mut start = x.to_vec();
-                start.push(if self.warm { 1.0 + 1e-3 } else { 2.0 });
-                (sdp::solve(&sdp, None, &start, settings), scale)
+                base_into(f, 1, &mut w.sdp);
+                self.constraint_blocks(w, floors, 1, lazy)?;
+                let epigraph = push_block(&mut w.sdp, |b| compliance_block(f, &u, scale, b));
+                w.sdp.c[k] = -1.0;
+                w.sdp.epigraph = Some((k, epigraph));
+                start_with(w, if self.warm { 1.0 + 1e-3 } else { 2.0 });
+                (sdp::solve(&w.sdp, None, &w.start, settings, &mut w.run), scale)
             }
         };
         if run.end != End::Optimum {
             return Err(not_converged(&run, gap));
         }
-        let mut x = run.x;
-        x.truncate(k);
-        Ok(Answer { x, upper: run.upper * scale, iterations: run.iterations })
-    }
-
-    /// `uᵀ J_p A⁻¹ J_pᵀ u` at `x` (`None` where `A ⊁ 0`).
-    fn compliance_at(&self, x: &[f64], u: &nalgebra::Vector3<f64>) -> Option<f64> {
-        let n = self.frame.n;
-        let mut a = vec![0.0; n * n];
-        self.frame.a_at(x, &mut a);
-        if !crate::dense::cholesky(&mut a, n) {
-            return None;
-        }
-        let b: Vec<f64> =
-            (0..n).map(|r| (0..3).map(|i| self.frame.j_x[i * n + r] * u[i]).sum()).collect();
-        let mut z = b.clone();
-        crate::dense::cholesky_solve(&a, n, &mut z);
-        Some(b.iter().zip(&z).map(|(p, q)| p * q).sum())
+        take_point(w, k);
+        Ok(Last { upper: run.upper * scale, iterations: run.iterations })
     }
 }
 

@@ -46,11 +46,13 @@ mod blocks;
 mod bundle;
 #[cfg(test)]
 mod checks;
+mod data;
 mod dense;
 mod error;
 mod frame;
 mod interior;
 mod ipm;
+mod ipm_work;
 mod kkt;
 mod least;
 mod margin_row;

@@ -11,10 +11,10 @@ use sinew_stiffness::{ArmStiffness, ArmStiffnessData, EndOutcome};
 use crate::active;
 use crate::answer::{Evaluated, plan_at, stable_margin};
 use crate::bundle::{self, Linear};
+pub use crate::data::PlannerData;
 use crate::error::{InputProblem, PlanError};
 use crate::frame::Frame;
 use crate::interior;
-use crate::least::LeastEigen;
 use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
@@ -29,57 +29,10 @@ pub struct Planner {
     arm: ArmStiffness,
 }
 
-/// The planner's workspace.
-#[derive(Debug)]
-pub struct PlannerData {
-    pub(crate) stiffness: ArmStiffnessData,
-    /// The last plan's tensions, for a rate limit and a warm start along a trajectory.
-    pub(crate) previous: Option<Vec<f64>>,
-    /// The last interior-point plan's active rows, with the number of rows of its frame (the
-    /// warm start's first active set when this frame has as many).
-    active: Option<(usize, Vec<usize>)>,
-    /// The last plan's pencil, its buffers reused by the next.
-    pub(crate) pencil: Option<Pencil>,
-    /// The answer's `sym(K_q + K_W)` (row-major) and its least eigenvalue's workspace.
-    pub(crate) margin: (Vec<f64>, LeastEigen),
-    /// The last plan's equilibrium set: the next pose's is copied into its buffers.
-    set: Option<EquilibriumSet>,
-    /// The last interior-point plan's frame, its buffers reused by the next.
-    frame: Option<Frame>,
-    /// The last plan's rows in `λ`, merged, and the merge's scratch.
-    rows: Option<(Linear, Linear, Vec<usize>)>,
-    /// The warm step's buffers.
-    warm: active::WarmWork,
-}
-
 impl PlannerData {
     /// A workspace for `planner`.
     pub fn new(planner: &Planner) -> PlannerData {
-        PlannerData {
-            stiffness: ArmStiffnessData::new(&planner.arm),
-            previous: None,
-            active: None,
-            pencil: None,
-            margin: (Vec::new(), LeastEigen::default()),
-            set: None,
-            frame: None,
-            rows: None,
-            warm: active::WarmWork::default(),
-        }
-    }
-
-    /// Forget the previous plan (its tensions and the margin's last eigenvector): the next
-    /// plan is cold and depends on its own arguments only.
-    pub(crate) fn forget(&mut self) {
-        self.previous = None;
-        self.margin.1.forget();
-        self.warm.forget();
-    }
-
-    /// The stiffness workspace of the last plan (the arm evaluated at its tensions; its
-    /// [`ArmStiffnessData::pose_stages`] counts the pose stages the plans have run).
-    pub fn stiffness(&self) -> &ArmStiffnessData {
-        &self.stiffness
+        PlannerData::for_arm(&planner.arm)
     }
 }
 
@@ -202,24 +155,27 @@ impl Planner {
                     interior::warm(&frame, objective, requirements, settings, active, &mut work)
                 });
                 let limited = rate.is_some() && previous.is_some();
-                let cold = |data: &mut PlannerData| {
-                    interior::cold(&frame, objective, requirements, settings).map_err(|e| match e {
-                        PlanError::BudgetsInfeasible => {
-                            self.infeasible(data, requirements, limited)
-                        }
-                        e => e,
-                    })
+                let mut cold = |data: &mut PlannerData| {
+                    interior::cold(&frame, objective, requirements, settings, &mut work)
+                        .map_err(|e| self.infeasible(data, requirements, limited, e))
                 };
                 let (answer, before) = match attempt {
                     Some(Ok(answer)) => {
                         warm = true;
                         (answer, 0)
                     }
-                    Some(Err(tried)) => {
-                        let (answer, before) = cold(data)?;
-                        (answer, before + tried)
-                    }
-                    None => cold(data)?,
+                    // Cold, after the iterations of a refused warm start; on an error the
+                    // buffers go back into the workspace.
+                    attempt => match cold(data) {
+                        Ok((answer, before)) => {
+                            (answer, before + attempt.map_or(0, |t| t.err().unwrap_or(0)))
+                        }
+                        Err(e) => {
+                            data.active = taken;
+                            let taken = (frame, work, pencil, (linear, merged, keys));
+                            return Err(data.keep(taken, set, e));
+                        }
+                    },
                 };
                 let mut kept = taken.map(|(_, a)| a).unwrap_or_default();
                 active::active_rows_into(&frame, &answer.x, &mut kept, work.pairs());
@@ -251,7 +207,7 @@ impl Planner {
         data.rows = Some((linear, merged, keys));
         let plan = self.answer(data, &set, objective, requirements, lambda, upper, iterations)?;
         // The tensions into the last ones' buffer.
-        let mut kept = previous.unwrap_or_default();
+        let mut kept = previous.unwrap_or_else(|| std::mem::take(&mut data.warm.tensions));
         kept.clone_from(&plan.tensions);
         data.previous = Some(kept);
         data.set = Some(set);
@@ -357,15 +313,20 @@ impl Planner {
         plan_at(objective, (lambda, tensions), at, upper, iterations, levels)
     }
 
-    /// Why no point meets the rows of a plan at the pose of `data`: an infeasible load (the
-    /// statics' typed error, by the least-total policy), a budget below the least total, the rate
-    /// limit, or the per-joint budgets.
+    /// `error`, or where it is [`PlanError::BudgetsInfeasible`], why no point meets the rows of
+    /// a plan at the pose of `data`: an infeasible load (the statics' typed error, by the
+    /// least-total policy), a budget below the least total, the rate limit, or the per-joint
+    /// budgets.
     fn infeasible(
         &self,
         data: &mut PlannerData,
         requirements: &Requirements,
         limited: bool,
+        error: PlanError,
     ) -> PlanError {
+        if !matches!(error, PlanError::BudgetsInfeasible) {
+            return error;
+        }
         let sd = &mut data.stiffness;
         if let Err(e) = self.arm.set_tensions(sd, TensionChoice::Policy(TensionPolicy::LeastTotal))
         {

@@ -23,7 +23,7 @@ use crate::dense::cholesky;
 use crate::dense::inner;
 
 /// One matrix inequality `F(x) = F_0 + Σ_a x_a F_a ⪰ 0` (each n × n, row-major, symmetric).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Block {
     pub(crate) n: usize,
     pub(crate) constant: Vec<f64>,
@@ -32,6 +32,8 @@ pub(crate) struct Block {
     /// The same coefficients as congruences of small blocks, where the block has them (a
     /// stiffness floor of the decoupled model); only the Schur terms read them.
     pub(crate) factors: Option<Factors>,
+    /// The buffers of earlier coefficients, for [`Block::fresh`].
+    pub(crate) spare: Vec<Vec<f64>>,
 }
 
 /// Coefficients `F_a = R_aᵀ B_a R_a`, `R_a` the rows `span_a` of a basis `R` (q × n,
@@ -47,6 +49,26 @@ pub(crate) struct Factors {
 }
 
 impl Block {
+    /// The block emptied for `count` variables, n × n, its constant zero: every coefficient
+    /// `None`, their buffers kept for [`Block::fresh`] (so that refilling a block of the same
+    /// shape allocates nothing).
+    pub(crate) fn recycle(&mut self, n: usize, count: usize) {
+        self.n = n;
+        self.constant.clear();
+        self.constant.resize(n * n, 0.0);
+        self.spare.extend(self.coefficients.drain(..).flatten());
+        self.coefficients.resize(count, None);
+        self.factors = None;
+    }
+
+    /// A zero buffer of `len` entries, an earlier coefficient's where there is one.
+    pub(crate) fn fresh(&mut self, len: usize) -> Vec<f64> {
+        let mut v = self.spare.pop().unwrap_or_default();
+        v.clear();
+        v.resize(len, 0.0);
+        v
+    }
+
     /// `F(x)` into `out`.
     pub(crate) fn at(&self, x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(&self.constant);
@@ -73,9 +95,25 @@ pub(crate) struct Sdp {
     pub(crate) hi: Vec<f64>,
     /// `(variable, block)` of an epigraph variable.
     pub(crate) epigraph: Option<(usize, usize)>,
+    /// Earlier blocks, for [`Sdp::next_block`].
+    pub(crate) spare: Vec<Block>,
 }
 
 impl Sdp {
+    /// Every block moved to the spares (their buffers kept), the epigraph removed.
+    pub(crate) fn clear_blocks(&mut self) {
+        // Last first: the next `next_block` returns the earlier first block.
+        while let Some(b) = self.blocks.pop() {
+            self.spare.push(b);
+        }
+        self.epigraph = None;
+    }
+
+    /// A block to fill ([`Block::recycle`]) and push: an earlier one where there is one.
+    pub(crate) fn next_block(&mut self) -> Block {
+        self.spare.pop().unwrap_or_default()
+    }
+
     pub(crate) fn vars(&self) -> usize {
         self.c.len()
     }
@@ -119,12 +157,14 @@ pub(crate) struct Settings {
 pub(crate) struct Duals {
     pub(crate) y: Vec<f64>,
     pub(crate) z: Vec<Vec<f64>>,
+    /// Earlier blocks' `Z` buffers ([`resize_pooled`]).
+    pub(crate) spare: Vec<Vec<f64>>,
 }
 
-/// How a run ended: the last iterate, its value, its certified bound, the iterations.
+/// How a run ended: the last iterate's value, its certified bound, the iterations (the iterate
+/// itself is the run's workspace's, `SolveWork::x` in `sdp.rs`).
 #[derive(Debug, Clone)]
 pub(crate) struct Run {
-    pub(crate) x: Vec<f64>,
     pub(crate) value: f64,
     pub(crate) upper: f64,
     pub(crate) iterations: usize,
@@ -231,37 +271,43 @@ pub(crate) fn bound_at(
 
 /// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the
 /// least-squares fit of stationarity `∇φ + μ (−Gᵀ(1/s) + F*(S⁻¹)) = 0` (floored at a small
-/// positive value). An epigraph block gets its own `μ_t`, the one that makes the epigraph
-/// variable's stationarity exact (`∂φ/∂t + μ_t ⟨F_t, S⁻¹⟩ = 0`); the fit is then over the
-/// other coordinates.
-pub(crate) fn centred_duals(
+/// positive value), into `duals` (its buffers reused). `s_inverse(j)` is `S_j⁻¹`; `b` and
+/// `g` are scratch of the variables' length. An epigraph block gets its own `μ_t`, the one
+/// that makes the epigraph variable's stationarity exact (`∂φ/∂t + μ_t ⟨F_t, S⁻¹⟩ = 0`); the
+/// fit is then over the other coordinates.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn centred_duals<'w>(
     sdp: &Sdp,
     gradient: &[f64],
     s: &[f64],
-    s_inverses: &[&[f64]],
+    s_inverse: impl Fn(usize) -> &'w [f64],
     value: f64,
     scale: f64,
-) -> Duals {
+    (b, g): (&mut [f64], &mut [f64]),
+    duals: &mut Duals,
+) {
     let k = sdp.vars();
-    let mut own = vec![None; s_inverses.len()];
+    let mut own = None;
     if let Some((t, j)) = sdp.epigraph {
-        let d = sdp.blocks[j].coefficients[t].as_ref().map_or(0.0, |f| inner(f, s_inverses[j]));
+        let d = sdp.blocks[j].coefficients[t].as_ref().map_or(0.0, |f| inner(f, s_inverse(j)));
         let mu_t = -gradient[t] / d;
         if mu_t.is_finite() && mu_t > 0.0 {
-            own[j] = Some(mu_t);
+            own = Some((j, mu_t));
         }
     }
-    let mut b = vec![0.0; k];
-    let mut g = gradient.to_vec();
+    let own_of = |j: usize| own.and_then(|(e, mu_t)| (e == j).then_some(mu_t));
+    b.fill(0.0);
+    g.copy_from_slice(gradient);
     for (r, sr) in s.iter().enumerate() {
         for a in 0..k {
             b[a] -= sdp.rows[r * k + a] / sr;
         }
     }
-    for (j, (blk, w)) in sdp.blocks.iter().zip(s_inverses).enumerate() {
+    for (j, blk) in sdp.blocks.iter().enumerate() {
+        let w = s_inverse(j);
         for a in 0..k {
             if let Some(fa) = &blk.coefficients[a] {
-                match own[j] {
+                match own_of(j) {
                     Some(mu_t) => g[a] += mu_t * inner(fa, w),
                     None => b[a] += inner(fa, w),
                 }
@@ -273,16 +319,27 @@ pub(crate) fn centred_duals(
         g[t] = 0.0;
     }
     let bb: f64 = b.iter().map(|v| v * v).sum();
-    let gb: f64 = b.iter().zip(&g).map(|(x, y)| x * y).sum();
+    let gb: f64 = b.iter().zip(g.iter()).map(|(x, y)| x * y).sum();
     let nu = (s.len() + sdp.blocks.iter().map(|b| b.n).sum::<usize>()) as f64;
     let floor = 1e-3 * value.abs().max(scale) / nu.max(1.0);
     let mu = if bb > 0.0 { (-gb / bb).max(floor) } else { floor };
-    Duals {
-        y: s.iter().map(|v| mu / v).collect(),
-        z: s_inverses
-            .iter()
-            .zip(&own)
-            .map(|(w, o)| w.iter().map(|v| o.unwrap_or(mu) * v).collect())
-            .collect(),
+    duals.y.clear();
+    duals.y.extend(s.iter().map(|v| mu / v));
+    resize_pooled(&mut duals.z, &mut duals.spare, sdp.blocks.len());
+    for (j, z) in duals.z.iter_mut().enumerate() {
+        let m = own_of(j).unwrap_or(mu);
+        z.clear();
+        z.extend(s_inverse(j).iter().map(|v| m * v));
+    }
+}
+
+/// `v` to `len` entries: those cut go to `spare`, those added come from it (or are new), so
+/// that a buffer keeps its place and its room from one run to the next.
+pub(crate) fn resize_pooled<T: Default>(v: &mut Vec<T>, spare: &mut Vec<T>, len: usize) {
+    while v.len() > len {
+        spare.extend(v.pop());
+    }
+    while v.len() < len {
+        v.push(spare.pop().unwrap_or_default());
     }
 }

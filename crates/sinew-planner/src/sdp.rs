@@ -21,13 +21,14 @@
 use crate::block_work::{BlockWork, add_block_schur, matrix_step, step_length, sym_product, zs};
 use crate::dense::{axpy, cholesky, cholesky_inverse, cholesky_solve, dot, inner};
 pub(crate) use crate::program::{Block, Duals, End, Run, Sdp, Settings, Smooth};
-use crate::program::{centred_duals, upper_bound};
+use crate::program::{centred_duals, resize_pooled, upper_bound};
 
 /// How often a step that leaves the smooth objective's domain is halved before the run
 /// breaks down.
 const MAX_HALVINGS: usize = 30;
 
-/// The vectors of a run (rows, variables), allocated once per run.
+/// The vectors of a run (rows, variables), sized once per run.
+#[derive(Debug, Default)]
 struct Vectors {
     s: Vec<f64>,
     gradient: Vec<f64>,
@@ -43,26 +44,45 @@ struct Vectors {
     dy_aff: Vec<f64>,
     /// `x` before the last step.
     previous: Vec<f64>,
+    /// The centring's scratch ([`centred_duals`]).
+    centring: (Vec<f64>, Vec<f64>),
 }
 
 impl Vectors {
-    fn new(k: usize, p: usize) -> Vectors {
-        Vectors {
-            s: vec![0.0; p],
-            gradient: vec![0.0; k],
-            smooth_gradient: vec![0.0; k],
-            hessian: vec![0.0; k * k],
-            schur: vec![0.0; k * k],
-            factored: vec![0.0; k * k],
-            dx: vec![0.0; k],
-            dx_aff: vec![0.0; k],
-            ds_row: vec![0.0; p],
-            dy: vec![0.0; p],
-            ds_aff_row: vec![0.0; p],
-            dy_aff: vec![0.0; p],
-            previous: vec![0.0; k],
+    fn size(&mut self, k: usize, p: usize) {
+        for (v, len) in [
+            (&mut self.s, p),
+            (&mut self.gradient, k),
+            (&mut self.smooth_gradient, k),
+            (&mut self.hessian, k * k),
+            (&mut self.schur, k * k),
+            (&mut self.factored, k * k),
+            (&mut self.dx, k),
+            (&mut self.dx_aff, k),
+            (&mut self.ds_row, p),
+            (&mut self.dy, p),
+            (&mut self.ds_aff_row, p),
+            (&mut self.dy_aff, p),
+            (&mut self.previous, k),
+            (&mut self.centring.0, k),
+            (&mut self.centring.1, k),
+        ] {
+            v.clear();
+            v.resize(len, 0.0);
         }
     }
+}
+
+/// A run's workspace, kept between runs: once its buffers have the room of a problem, a run
+/// on a problem of that shape allocates nothing. After a run, `x` is its last iterate.
+#[derive(Debug, Default)]
+pub(crate) struct SolveWork {
+    /// The last iterate (the start where the run broke down).
+    pub(crate) x: Vec<f64>,
+    v: Vectors,
+    works: Vec<BlockWork>,
+    spare: Vec<BlockWork>,
+    duals: Duals,
 }
 
 /// Run the method from the strictly feasible `x0`, with multipliers centred there.
@@ -76,8 +96,9 @@ pub(crate) fn solve(
     smooth: Option<&mut dyn Smooth>,
     x0: &[f64],
     settings: Settings,
+    work: &mut SolveWork,
 ) -> Run {
-    pulp::Arch::new().dispatch(Solve { sdp, smooth, x0, settings })
+    pulp::Arch::new().dispatch(Solve { sdp, smooth, x0, settings, work })
 }
 
 /// The arguments of [`solve`] as a pulp operation.
@@ -86,6 +107,7 @@ struct Solve<'a, 'b> {
     smooth: Option<&'a mut (dyn Smooth + 'b)>,
     x0: &'a [f64],
     settings: Settings,
+    work: &'a mut SolveWork,
 }
 
 impl pulp::WithSimd for Solve<'_, '_> {
@@ -93,7 +115,7 @@ impl pulp::WithSimd for Solve<'_, '_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> Run {
-        solve_body(self.sdp, self.smooth, self.x0, self.settings)
+        solve_body(self.sdp, self.smooth, self.x0, self.settings, self.work)
     }
 }
 
@@ -103,16 +125,21 @@ fn solve_body<'s>(
     mut smooth: Option<&mut (dyn Smooth + 's)>,
     x0: &[f64],
     settings: Settings,
+    work: &mut SolveWork,
 ) -> Run {
     let k = sdp.vars();
     let p = sdp.row_count();
     let nu = (p + sdp.blocks.iter().map(|b| b.n).sum::<usize>()) as f64;
-    let mut works: Vec<BlockWork> = sdp.blocks.iter().map(BlockWork::new).collect();
-    let mut v = Vectors::new(k, p);
-    let mut x = x0.to_vec();
-    let mut duals = Duals::default();
+    let SolveWork { x, v, works, spare, duals } = work;
+    resize_pooled(works, spare, sdp.blocks.len());
+    for (w, b) in works.iter_mut().zip(&sdp.blocks) {
+        w.reset(b);
+    }
+    v.size(k, p);
+    x.clear();
+    x.extend_from_slice(x0);
     let mut best: Option<(f64, f64)> = None;
-    let run = |x: Vec<f64>, value, upper, iterations, end| Run { x, value, upper, iterations, end };
+    let run = |value, upper, iterations, end| Run { value, upper, iterations, end };
     // The last primal step's length: where the step leaves the smooth objective's domain
     // (which no block bounds when the margin is checked lazily, `ipm.rs`), it is halved.
     let mut last_step: Option<f64> = None;
@@ -120,10 +147,10 @@ fn solve_body<'s>(
         let mut halvings = 0;
         let (value, interior) = loop {
             // The slacks, their factors and inverses, the objective.
-            sdp.slacks(&x, &mut v.s);
+            sdp.slacks(x, &mut v.s);
             let mut interior = v.s.iter().all(|s| *s > 0.0);
             for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
-                b.at(&x, &mut w.s);
+                b.at(x, &mut w.s);
                 w.l.copy_from_slice(&w.s);
                 interior &= cholesky(&mut w.l, b.n);
                 if interior {
@@ -132,9 +159,9 @@ fn solve_body<'s>(
             }
             v.gradient.copy_from_slice(&sdp.c);
             v.hessian.fill(0.0);
-            let mut value = sdp.c0 + dot(&sdp.c, &x);
+            let mut value = sdp.c0 + dot(&sdp.c, x);
             if let Some(smooth) = smooth.as_deref_mut() {
-                match smooth.evaluate(&x, &mut v.smooth_gradient, &mut v.hessian) {
+                match smooth.evaluate(x, &mut v.smooth_gradient, &mut v.hessian) {
                     Some(psi) => {
                         value += psi;
                         axpy(1.0, &v.smooth_gradient, &mut v.gradient);
@@ -147,18 +174,21 @@ fn solve_body<'s>(
                     halvings += 1;
                     last_step = Some(0.5 * alpha);
                     x.copy_from_slice(&v.previous);
-                    axpy(0.5 * alpha, &v.dx, &mut x);
+                    axpy(0.5 * alpha, &v.dx, x);
                 }
                 _ => break (value, interior),
             }
         };
         if !interior {
             let (value, upper) = best.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
-            return run(x0.to_vec(), value, upper, iteration, End::Breakdown);
+            x.copy_from_slice(x0);
+            return run(value, upper, iteration, End::Breakdown);
         }
         if iteration == 0 {
-            let inverses: Vec<&[f64]> = works.iter().map(|w| w.s_inv.as_slice()).collect();
-            duals = centred_duals(sdp, &v.gradient, &v.s, &inverses, value, settings.scale);
+            let inverses = |j: usize| works[j].s_inv.as_slice();
+            let (b, g) = (&mut v.centring.0, &mut v.centring.1);
+            let (gradient, s) = (&v.gradient, &v.s);
+            centred_duals(sdp, gradient, s, inverses, value, settings.scale, (b, g), duals);
         }
         let s = &v.s;
         let mu = (dot(&duals.y, s)
@@ -166,7 +196,7 @@ fn solve_body<'s>(
             / nu.max(1.0);
         let upper = {
             let matrices = works.iter().map(|w| w.s.as_slice());
-            upper_bound(sdp, &x, value, &v.gradient, s, matrices, &duals)
+            upper_bound(sdp, x, value, &v.gradient, s, matrices, duals)
         };
         best = Some((value, upper));
         if let Some(target) = settings.target {
@@ -175,17 +205,17 @@ fn solve_body<'s>(
             if value > target
                 && (value - target >= settings.centring * (upper - target) || converged)
             {
-                return run(x, value, upper, iteration, End::Reached);
+                return run(value, upper, iteration, End::Reached);
             }
             if upper < target {
-                return run(x, value, upper, iteration, End::Unreachable);
+                return run(value, upper, iteration, End::Unreachable);
             }
         }
         if upper - value <= settings.relative_gap * value.abs().max(settings.scale) {
-            return run(x, value, upper, iteration, End::Optimum);
+            return run(value, upper, iteration, End::Optimum);
         }
         if iteration == settings.max_iterations || p + works.len() == 0 {
-            return run(x, value, upper, iteration, End::NotConverged);
+            return run(value, upper, iteration, End::NotConverged);
         }
         // The Schur complement.
         for (e, h) in v.schur.iter_mut().zip(&v.hessian) {
@@ -212,13 +242,13 @@ fn solve_body<'s>(
                 v.factored[a * k + a] += 1e-12 * trace;
             }
             if !cholesky(&mut v.factored, k) {
-                return run(x, value, upper, iteration, End::Breakdown);
+                return run(value, upper, iteration, End::Breakdown);
             }
         }
         // Predictor (σ = 0).
         v.dx_aff.copy_from_slice(&v.gradient);
         cholesky_solve(&v.factored, k, &mut v.dx_aff);
-        directions(sdp, s, &duals, &v.dx_aff, 0.0, &mut v.ds_aff_row, &mut v.dy_aff);
+        directions(sdp, s, duals, &v.dx_aff, 0.0, &mut v.ds_aff_row, &mut v.dy_aff);
         for ((b, w), z) in sdp.blocks.iter().zip(works.iter_mut()).zip(&duals.z) {
             matrix_step(b, &v.dx_aff, &mut w.ds_aff);
             // ΔZ = −Z − sym(Z ΔS S⁻¹).
@@ -227,9 +257,9 @@ fn solve_body<'s>(
                 *d = -zz - o;
             }
         }
-        let alpha_p = step_length(s, &v.ds_aff_row, &mut works, |w| (&w.s, &w.ds_aff));
-        zs(&mut works, &duals);
-        let alpha_d = step_length(&duals.y, &v.dy_aff, &mut works, |w| (&w.t2, &w.dz_aff));
+        let alpha_p = step_length(s, &v.ds_aff_row, works, |w| (&w.s, &w.ds_aff));
+        zs(works, duals);
+        let alpha_d = step_length(&duals.y, &v.dy_aff, works, |w| (&w.t2, &w.dz_aff));
         let mut mu_aff = 0.0;
         for r in 0..p {
             mu_aff += (s[r] + alpha_p * v.ds_aff_row[r]) * (duals.y[r] + alpha_d * v.dy_aff[r]);
@@ -261,7 +291,7 @@ fn solve_body<'s>(
             }
         }
         cholesky_solve(&v.factored, k, &mut v.dx);
-        directions(sdp, s, &duals, &v.dx, sigma_mu, &mut v.ds_row, &mut v.dy);
+        directions(sdp, s, duals, &v.dx, sigma_mu, &mut v.ds_row, &mut v.dy);
         for r in 0..p {
             v.dy[r] -= v.ds_aff_row[r] * v.dy_aff[r] / s[r];
         }
@@ -272,14 +302,14 @@ fn solve_body<'s>(
                 w.dz[e] = w.correction[e] - z[e] - w.product[e];
             }
         }
-        let alpha_p = step_length(s, &v.ds_row, &mut works, |w| (&w.s, &w.ds));
-        zs(&mut works, &duals);
-        let alpha_d = step_length(&duals.y, &v.dy, &mut works, |w| (&w.t2, &w.dz));
-        v.previous.copy_from_slice(&x);
+        let alpha_p = step_length(s, &v.ds_row, works, |w| (&w.s, &w.ds));
+        zs(works, duals);
+        let alpha_d = step_length(&duals.y, &v.dy, works, |w| (&w.t2, &w.dz));
+        v.previous.copy_from_slice(x);
         last_step = Some(alpha_p);
-        axpy(alpha_p, &v.dx, &mut x);
+        axpy(alpha_p, &v.dx, x);
         axpy(alpha_d, &v.dy, &mut duals.y);
-        for (z, w) in duals.z.iter_mut().zip(&works) {
+        for (z, w) in duals.z.iter_mut().zip(works.iter()) {
             axpy(alpha_d, &w.dz, z);
             crate::dense::symmetrise(z, w.n);
         }

@@ -96,21 +96,18 @@ pub(crate) struct EndAt {
 }
 
 impl<'a> EndObjective<'a> {
+    #[cfg(test)]
     pub(crate) fn new(frame: &'a Frame, kind: Kind, scale: f64) -> EndObjective<'a> {
         Self::reusing(frame, kind, scale, EndBuffers::default())
     }
 
-    /// Buffers for [`Self::end_at`] only (`K_x` at a point, no derivatives).
-    pub(crate) fn end_only(frame: &'a Frame) -> EndObjective<'a> {
-        Self::with_columns(frame, Kind::Volume, 1.0, 0)
+    /// For [`Self::end_at`] only (`K_x` at a point, no derivatives), in the buffers of an
+    /// earlier objective.
+    pub(crate) fn end_only(frame: &'a Frame, buffers: EndBuffers) -> EndObjective<'a> {
+        Self::in_buffers(frame, Kind::Volume, 1.0, 0, buffers)
     }
 
-    /// The buffers of the derivatives sized for `c` vectors `z_j`.
-    fn with_columns(frame: &'a Frame, kind: Kind, scale: f64, c: usize) -> EndObjective<'a> {
-        Self::in_buffers(frame, kind, scale, c, EndBuffers::default())
-    }
-
-    /// [`EndObjective::new`] in the buffers of an earlier objective ([`Self::into_buffers`]):
+    /// A smooth objective in the buffers of an earlier objective ([`Self::into_buffers`]):
     /// no allocation once they have the room.
     pub(crate) fn reusing(
         frame: &'a Frame,

@@ -106,7 +106,8 @@ impl Planner {
         let linear = linear_rows(&set, requirements.budget, &self.joint_budget_rows(requirements));
         let frame = Frame::new(&pencil, &set, &linear.merged(), &[]);
         data.pencil = Some(pencil);
-        let (answer, before) = interior::cold(&frame, objective, requirements, settings)?;
+        let (answer, before) =
+            interior::cold(&frame, objective, requirements, settings, &mut data.warm)?;
         let lambda = frame.lambda(&answer.x);
         // The answer, evaluated by the friction pipeline at its actuator tensions.
         let mut tensions = vec![0.0; set.cable_count()];

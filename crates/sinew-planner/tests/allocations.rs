@@ -1,12 +1,14 @@
-//! The interior-point method's iterations allocate nothing: its buffers are sized once per
-//! run. A counting global allocator (this test binary only) counts every allocation of a plan
-//! capped at 2, 4 and 6 iterations (each ends `NotConverged` in its last phase); equal counts
-//! mean the iterations past the second allocated nothing. A method that allocated a scratch
-//! vector per iteration, or per step-length trial, gives counts that grow with the cap.
+//! A plan allocates only the plan it returns once its workspace has the room, cold or warm. A
+//! counting global allocator (this test binary only) counts every allocation:
 //!
-//! The set-up of a cold plan still allocates (the blocks of each phase, the programs' vectors,
-//! the plan's own vectors): counted here, not claimed to be zero. A warm step along a
-//! trajectory allocates only the plan it returns (the last test).
+//! - of a cold plan capped at 2, 4 and 6 iterations (each ends `NotConverged` in its last
+//!   phase): none. A method that allocated a scratch vector per iteration, or per step-length
+//!   trial, gives counts that grow with the cap; one that built a phase's blocks or its run's
+//!   buffers anew, or dropped the workspace's buffers on an error, counts more than zero
+//!   (before the phases worked in the workspace's buffers, 152–272 a plan);
+//! - of a cold plan to its answer, with and without stiffness floors and a budget: its plan's
+//!   own vectors only;
+//! - of a warm step along a trajectory: its plan's own vectors only (the last test).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Vector3, Vector6};
@@ -95,12 +97,78 @@ fn iterations_of_the_interior_point_method_allocate_nothing() {
                 objective.name()
             );
             assert!(
-                counts.iter().all(|c| *c == counts[0]),
-                "{model:?} {}: allocations grow with the iterations: {counts:?}",
+                counts.iter().all(|c| *c == 0),
+                "{model:?} {}: a capped plan allocates: {counts:?}",
                 objective.name()
             );
         }
     }
+}
+
+/// A cold plan to its answer allocates its plan's own vectors only (`λ`, the tensions, and the
+/// levels where the arm has the closed form), under requirements that run every phase: none,
+/// a floor on the least stiffness (`k_min`, 0.8 of the best), a floor `K_des` (half the best
+/// plan's `K_fd`), and a budget between the least and the free optimum's totals. The least of
+/// three counts, after two plans that size the workspace's buffers.
+#[test]
+fn a_cold_plan_allocates_only_its_plan() {
+    let _serial = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    assert_counting();
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+    let settings = PlanSettings::default();
+    let mut plans = 0;
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        let mut data = PlannerData::new(&planner);
+        let own = 2 + usize::from(planner.arm().statics().has_levels());
+        let q = &cdhrm5::LOADED_POSE;
+        let plan = |data: &mut PlannerData, objective, requirements: &Requirements| {
+            planner.plan(data, q, &f0, objective, requirements, &settings)
+        };
+        let none = Requirements::default();
+        let best = plan(&mut data, Objective::MinStiffness, &none).unwrap();
+        let least = plan(&mut data, Objective::LeastTension, &none).unwrap();
+        let free = plan(&mut data, Objective::Volume, &none).unwrap();
+        let variants = [
+            ("none", none.clone()),
+            ("k_min", Requirements { k_min: Some(0.8 * best.value), ..none.clone() }),
+            ("K_des", Requirements { k_des: Some(0.5 * best.k_fd.unwrap()), ..none.clone() }),
+            (
+                "budget",
+                Requirements {
+                    budget: Some(0.5 * (least.total_tension + free.total_tension)),
+                    ..none.clone()
+                },
+            ),
+        ];
+        for (name, requirements) in &variants {
+            for objective in objectives() {
+                for _ in 0..2 {
+                    plan(&mut data, objective, requirements).unwrap();
+                }
+                let mut counts = Vec::new();
+                for _ in 0..3 {
+                    let (allocations, result) = count(|| plan(&mut data, objective, requirements));
+                    result.unwrap();
+                    counts.push(allocations);
+                }
+                let least_count = counts.iter().copied().min().unwrap();
+                println!(
+                    "{model:?} {} {name}: allocations of a cold plan: {counts:?}",
+                    objective.name()
+                );
+                assert_eq!(
+                    least_count,
+                    own,
+                    "{model:?} {} {name}: a cold plan allocates more than its plan's {own} vectors",
+                    objective.name()
+                );
+                plans += 1;
+            }
+        }
+    }
+    assert_eq!(plans, 2 * 4 * 5);
 }
 
 /// A warm step along a trajectory allocates only its plan's own vectors (`λ`, the tensions,
