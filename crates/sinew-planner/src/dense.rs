@@ -83,7 +83,7 @@ fn cholesky_fixed<const N: usize>(a: &mut [f64]) -> bool {
     let (rows, _) = a[..N * N].as_chunks_mut::<N>();
     for j in 0..N {
         let d = rows[j][j];
-        if !(d > 0.0 && d.is_finite()) {
+        if !(d > 0.0 && d < f64::INFINITY) {
             return false;
         }
         let d = d.sqrt();
