@@ -1,7 +1,7 @@
 //! `cargo bench -p sinew-planner`: a certified plan (relative gap 1e-6) on cdhrm5 at the loaded
 //! pose under 5 N along y (both models, every objective, both methods), one pipeline evaluation
 //! of the same arm (the ratio is what carries to another machine), 100 warm-started steps along
-//! a 1 kHz trajectory, a 25-joint decoupled chain (50 DOF, weightless, 0.022 N at the tip) and a
+//! a 1 kHz trajectory and one warm step of it as a controller makes it (`replan`), a 25-joint decoupled chain (50 DOF, weightless, 0.022 N at the tip) and a
 //! 100-joint one (200 DOF, 0.00045 N), and plans in the stick regime (μ = 0.1).
 //! Prints each plan's iterations once, for the time per iteration.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -148,6 +148,30 @@ fn bench_plans(c: &mut Criterion) {
                         &settings,
                         None,
                     )
+                })
+            });
+            // One warm step as a controller makes it (`replan`, the next pose of the same
+            // trajectory, cycling): the time of the warm steps alone, each timed by itself;
+            // the cold ones (the first of each cycle, and any the warm path refuses) are
+            // planned but neither timed nor counted.
+            group.bench_function(format!("cdhrm5 {name} warm step {label}"), |b| {
+                let mut k = 0;
+                b.iter_custom(|iterations| {
+                    let mut total = std::time::Duration::ZERO;
+                    let mut timed = 0;
+                    while timed < iterations {
+                        let started = std::time::Instant::now();
+                        let step = planner
+                            .replan(&mut data, &steps[k], objective, &requirements, &settings, None)
+                            .unwrap();
+                        let spent = started.elapsed();
+                        if step.warm {
+                            total += spent;
+                            timed += 1;
+                        }
+                        k = (k + 1) % steps.len();
+                    }
+                    total
                 })
             });
         }

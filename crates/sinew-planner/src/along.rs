@@ -67,29 +67,74 @@ impl crate::Planner {
         settings: &crate::PlanSettings,
         rate: Option<RateLimit>,
     ) -> Result<Vec<AlongStep>, crate::PlanError> {
-        use crate::{InputProblem, PlanError};
-        if let Some(r) = rate {
-            for (what, v) in [("max_rate", r.max_rate), ("dt", r.dt)] {
-                if !(v.is_finite() && v > 0.0) {
-                    let problem = InputProblem::NotPositive { unit: "", reason: "" };
-                    return Err(PlanError::InvalidInput { what, problem });
-                }
-            }
-        }
+        check_rate(rate)?;
         data.forget();
         let change = rate.map(|r| r.max_change());
         let mut out = Vec::with_capacity(steps.len());
         for step in steps {
-            let result =
-                self.plan_step(data, &step.q, &step.f0, objective, requirements, settings, change);
-            out.push(match result {
-                Ok((plan, warm, iterations)) => AlongStep { plan: Ok(plan), warm, iterations },
-                Err(e) => {
-                    data.previous = None;
-                    AlongStep { plan: Err(e), warm: false, iterations: 0 }
-                }
-            });
+            out.push(self.next_step(data, step, objective, requirements, settings, change));
         }
         Ok(out)
     }
+
+    /// One step of re-planning in a control loop, where the poses come one at a time: the
+    /// plan at `step`, warm-started from the tensions of the last plan made in `data` (by
+    /// [`Self::plan`], [`Self::plan_along`] or `replan`) as the steps of [`Self::plan_along`]
+    /// are, with `rate` bounding each cable's change from them. With no last plan (a new
+    /// workspace, or a last step that had none) the step runs cold. [`Self::plan`] at a
+    /// trajectory's first step and then `replan` at each of the others give the plans
+    /// [`Self::plan_along`] gives.
+    ///
+    /// # Errors
+    /// [`crate::PlanError::InvalidInput`] for a rate or time step that is not finite and
+    /// positive (then the step is not planned).
+    pub fn replan(
+        &self,
+        data: &mut crate::PlannerData,
+        step: &Step,
+        objective: crate::Objective,
+        requirements: &crate::Requirements,
+        settings: &crate::PlanSettings,
+        rate: Option<RateLimit>,
+    ) -> Result<AlongStep, crate::PlanError> {
+        check_rate(rate)?;
+        let change = rate.map(|r| r.max_change());
+        Ok(self.next_step(data, step, objective, requirements, settings, change))
+    }
+
+    /// A step warm-started from the last plan in `data`; after a step without a plan the next
+    /// starts cold.
+    fn next_step(
+        &self,
+        data: &mut crate::PlannerData,
+        step: &Step,
+        objective: crate::Objective,
+        requirements: &crate::Requirements,
+        settings: &crate::PlanSettings,
+        change: Option<f64>,
+    ) -> AlongStep {
+        let result =
+            self.plan_step(data, &step.q, &step.f0, objective, requirements, settings, change);
+        match result {
+            Ok((plan, warm, iterations)) => AlongStep { plan: Ok(plan), warm, iterations },
+            Err(e) => {
+                data.previous = None;
+                AlongStep { plan: Err(e), warm: false, iterations: 0 }
+            }
+        }
+    }
+}
+
+/// A rate limit's rate and time step are finite and positive.
+fn check_rate(rate: Option<RateLimit>) -> Result<(), crate::PlanError> {
+    use crate::{InputProblem, PlanError};
+    if let Some(r) = rate {
+        for (what, v) in [("max_rate", r.max_rate), ("dt", r.dt)] {
+            if !(v.is_finite() && v > 0.0) {
+                let problem = InputProblem::NotPositive { unit: "", reason: "" };
+                return Err(PlanError::InvalidInput { what, problem });
+            }
+        }
+    }
+    Ok(())
 }

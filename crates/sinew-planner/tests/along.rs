@@ -174,3 +174,75 @@ fn a_bad_rate_is_refused_before_any_step() {
         assert!(matches!(result, Err(PlanError::InvalidInput { .. })));
     }
 }
+
+/// `replan`, one pose at a time as a controller gets them: `plan` at the first step and then
+/// `replan` at each of the others give `plan_along`'s plans bit for bit, warm where it is warm,
+/// with and without a rate limit, in both models. A `replan` that mapped from the wrong
+/// tensions (or ignored the last plan, or dropped the rate rows) gives other tensions or other
+/// warm flags.
+#[test]
+fn replanning_one_pose_at_a_time_gives_plan_along_s_plans() {
+    let steps = trajectory(60);
+    let settings = PlanSettings::default();
+    let requirements = Requirements::default();
+    for model in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(model);
+        let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+        for (objective, rate) in [
+            (Objective::StiffnessAlong(Vector3::y()), None),
+            (Objective::Volume, Some(RateLimit { max_rate: 2000.0, dt: DT })),
+        ] {
+            let along = run(&planner, &steps, objective, rate);
+            let mut data = PlannerData::new(&planner);
+            let first = planner.plan(
+                &mut data,
+                &steps[0].q,
+                &steps[0].f0,
+                objective,
+                &requirements,
+                &settings,
+            );
+            let bits = |p: &sinew_planner::Plan| {
+                p.tensions.iter().map(|f| f.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&first.unwrap()), bits(along[0].plan.as_ref().unwrap()));
+            let mut warm = 0;
+            for (k, step) in steps.iter().enumerate().skip(1) {
+                let one = planner
+                    .replan(&mut data, step, objective, &requirements, &settings, rate)
+                    .unwrap();
+                let (a, b) = (one.plan.as_ref().unwrap(), along[k].plan.as_ref().unwrap());
+                assert_eq!(bits(a), bits(b), "{model:?} {} step {k}", objective.name());
+                assert_eq!((one.warm, one.iterations), (along[k].warm, along[k].iterations));
+                warm += usize::from(one.warm);
+            }
+            // Warm-started, not cold at every step.
+            assert!(warm >= 50, "{model:?} {}: {warm} of 59 warm", objective.name());
+        }
+    }
+    // A bad rate is refused; after a step without a plan the next runs cold.
+    let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Decoupled);
+    let planner = Planner::new(ArmStiffness::new(&robot, &routing).unwrap());
+    let mut data = PlannerData::new(&planner);
+    let objective = Objective::StiffnessAlong(Vector3::y());
+    let bad = RateLimit { max_rate: 0.0, dt: DT };
+    let refused =
+        planner.replan(&mut data, &steps[0], objective, &requirements, &settings, Some(bad));
+    assert!(
+        matches!(refused, Err(PlanError::InvalidInput { what: "max_rate", .. })),
+        "{refused:?}"
+    );
+    let first =
+        planner.replan(&mut data, &steps[0], objective, &requirements, &settings, None).unwrap();
+    assert!(first.plan.is_ok() && !first.warm);
+    let second =
+        planner.replan(&mut data, &steps[1], objective, &requirements, &settings, None).unwrap();
+    assert!(second.plan.is_ok() && second.warm);
+    let slow = Some(RateLimit { max_rate: 1e-6, dt: DT });
+    let far = Step { q: vec![0.3; 10], f0: steps[0].f0 };
+    let jump = planner.replan(&mut data, &far, objective, &requirements, &settings, slow).unwrap();
+    assert!(matches!(jump.plan, Err(PlanError::RateLimitInfeasible)), "{:?}", jump.plan);
+    let after =
+        planner.replan(&mut data, &steps[2], objective, &requirements, &settings, None).unwrap();
+    assert!(after.plan.is_ok() && !after.warm);
+}
