@@ -270,15 +270,14 @@ fn add_factored_schur(
         crate::dense::multiply_fast(fa, z, n, &mut w.fz[a]);
         crate::dense::multiply_fast(&w.s_inv, fa, n, &mut w.sf[a]);
         // Z F_d S⁻¹ = (F_d Z)ᵀ S⁻¹, into t1; then R (·) Rᵀ.
-        let t = &mut w.t1;
-        t.fill(0.0);
-        for kk in 0..n {
-            let srow = &w.s_inv[kk * n..kk * n + n];
-            for i in 0..n {
-                axpy(w.fz[a][kk * n + i], srow, &mut t[i * n..i * n + n]);
-            }
+        {
+            use faer::{Accum, MatMut, MatRef, Par};
+            let fz = MatRef::from_row_major_slice(&w.fz[a][..n * n], n, n);
+            let s_inv = MatRef::from_row_major_slice(&w.s_inv[..n * n], n, n);
+            let t = MatMut::from_row_major_slice_mut(&mut w.t1[..n * n], n, n);
+            faer::linalg::matmul::matmul(t, Accum::Replace, fz.transpose(), s_inv, 1.0, Par::Seq);
         }
-        congruent(r, t, q, n, &mut w.rx, &mut w.rqr[a]);
+        congruent(r, &w.t1, q, n, &mut w.rx, &mut w.rqr[a]);
     }
     for a in 0..k {
         if b.coefficients.get(a).is_none_or(Option::is_none) {
@@ -306,23 +305,18 @@ fn add_factored_schur(
     }
 }
 
-/// `out = R X Rᵀ` (R q × n, X n × n, both row-major; `rx` q × n scratch).
+/// `out = R X Rᵀ` (R q × n, X n × n, both row-major; `rx` q × n scratch): two products by
+/// faer's kernels (the blocks factored are above the fixed-size kernels' sizes).
 #[inline(always)]
 fn congruent(r: &[f64], x: &[f64], q: usize, n: usize, rx: &mut [f64], out: &mut [f64]) {
-    for i in 0..q {
-        let row = &mut rx[i * n..i * n + n];
-        row.fill(0.0);
-        for (kk, rik) in r[i * n..i * n + n].iter().enumerate() {
-            if *rik != 0.0 {
-                axpy(*rik, &x[kk * n..kk * n + n], row);
-            }
-        }
-    }
-    for i in 0..q {
-        for j in 0..q {
-            out[i * q + j] = dot(&rx[i * n..i * n + n], &r[j * n..j * n + n]);
-        }
-    }
+    use faer::linalg::matmul::matmul;
+    use faer::{Accum, MatMut, MatRef, Par};
+    let r = MatRef::from_row_major_slice(&r[..q * n], q, n);
+    let x = MatRef::from_row_major_slice(&x[..n * n], n, n);
+    let mut rx = MatMut::from_row_major_slice_mut(&mut rx[..q * n], q, n);
+    matmul(rx.as_mut(), Accum::Replace, r, x, 1.0, Par::Seq);
+    let out = MatMut::from_row_major_slice_mut(&mut out[..q * q], q, q);
+    matmul(out, Accum::Replace, rx.as_ref(), r.transpose(), 1.0, Par::Seq);
 }
 
 /// `tr(B_a W[s_a, s_b] B_b V[s_b, s_a])` (`W`, `V` q × q).
