@@ -28,7 +28,7 @@
 //! [`PlanError::NonConservativeLoad`].
 //!
 //! [`Planner::plan_along`] re-plans along a trajectory, warm-started ([`Step`], [`RateLimit`],
-//! [`AlongStep`]). [`Planner::plan_in_stick`] plans with friction at the holes, in the stick
+//! [`AlongStep`]); [`Planner::replan`] makes one such step at a time, for a control loop. [`Planner::plan_in_stick`] plans with friction at the holes, in the stick
 //! regime after a history (spec §9: `K_stick` is affine in the actuator tensions and
 //! symmetric, so the same problem and certificate apply; [`StickPlanData`]).
 //!
