@@ -124,15 +124,20 @@ enum Goal<'a> {
 }
 
 impl Goal<'_> {
+    /// The value, the gradient and, unless `gradient_only`, the Hessian at `x` (else the
+    /// Hessian is left as it was, or zero for the linear objective).
     fn evaluate(
         &mut self,
         frame: &Frame,
         x: &[f64],
-        gradient: &mut [f64],
-        hessian: &mut [f64],
+        (gradient, hessian): (&mut [f64], &mut [f64]),
+        gradient_only: bool,
     ) -> Option<f64> {
         match self {
-            Goal::Smooth(s) => s.evaluate(x, gradient, hessian),
+            Goal::Smooth(s) => {
+                s.gradient_only = gradient_only;
+                s.evaluate(x, gradient, hessian)
+            }
             Goal::Linear => {
                 gradient.iter_mut().zip(&frame.sums).for_each(|(g, s)| *g = -s);
                 hessian.fill(0.0);
@@ -286,7 +291,9 @@ fn steps(
                 cholesky(a, n)
             };
         }
-        let value = goal.evaluate(frame, x, gradient, hessian).ok_or(step)?;
+        // The value and gradient first: they decide the certificate, which most warm steps
+        // meet at their first point; the Hessian only where a Newton step follows.
+        let value = goal.evaluate(frame, x, (gradient, hessian), true).ok_or(step)?;
         let (scale, floor) = *scale.get_or_insert_with(|| match objective {
             Objective::Volume => (value.abs().max(1.0), 1.0 / value.abs().max(1.0)),
             _ => (value.abs().max(1e-12), 1e-9),
@@ -321,6 +328,9 @@ fn steps(
                 return Ok(Answer { x, upper: upper * scale, iterations: step + 1 });
             }
         }
+        // Not certified: the Hessian at x (and the gradient again, the same to the bit).
+        goal.evaluate(frame, x, (gradient, hessian), false).ok_or(step)?;
+        gradient.iter_mut().chain(hessian.iter_mut()).for_each(|v| *v /= scale);
         // The Lagrangian's Hessian, and the margin's target: `c = δ` inside it by a quarter of
         // the tolerance's worth of objective (`η δ`), so that the answer is strictly stable.
         let margin_row = with_margin.then(|| {

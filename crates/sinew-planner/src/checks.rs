@@ -76,6 +76,33 @@ fn evaluate(objective: &mut EndObjective<'_>, x: &[f64]) -> (f64, Vec<f64>, Vec<
     (v, g, h)
 }
 
+/// A warm step's first evaluation (`gradient_only`) gives the full evaluation's value and
+/// gradient to the bit and leaves the Hessian as it was: one that stopped before the gradient
+/// was complete, or scaled or wrote the Hessian, fails.
+#[test]
+fn a_gradient_only_evaluation_is_the_full_one_without_the_hessian() {
+    for model in cdhrm5::MODELS {
+        let f = frame(model);
+        let k = f.vars();
+        let u = nalgebra::Vector3::new(0.6, 0.0, 0.8);
+        let w = Vector6::new(0.0, 0.6, 0.8, 0.0, 0.0, 0.0);
+        for kind in [Kind::Along(w), Kind::Volume, Kind::Compliance(u), Kind::Least] {
+            let mut objective = EndObjective::new(&f, kind, 3.0);
+            for x in stable_points(&f, 1e-3, 3, 9) {
+                let (v, g, h) = evaluate(&mut objective, &x);
+                assert!(h.iter().any(|e| *e != 0.0));
+                objective.gradient_only = true;
+                let (mut g_only, mut h_kept) = (vec![0.0; k], vec![7.0; k * k]);
+                let v_only = objective.evaluate(&x, &mut g_only, &mut h_kept).unwrap();
+                objective.gradient_only = false;
+                assert_eq!(v_only.to_bits(), v.to_bits(), "{model:?} {kind:?}");
+                assert!(g_only.iter().zip(&g).all(|(a, b)| a.to_bits() == b.to_bits()));
+                assert!(h_kept.iter().all(|e| *e == 7.0), "{model:?} {kind:?}: Hessian written");
+            }
+        }
+    }
+}
+
 #[test]
 fn smooth_gradients_and_hessians_match_central_differences_and_are_concave() {
     for model in cdhrm5::MODELS {

@@ -66,6 +66,9 @@ pub(crate) struct EndObjective<'a> {
     pub(crate) frame: &'a Frame,
     pub(crate) kind: Kind,
     pub(crate) scale: f64,
+    /// Evaluate the value and the gradient only, the Hessian left as it was (a warm step's
+    /// first evaluation, which most often certifies the point without a Newton step).
+    pub(crate) gradient_only: bool,
     b: EndBuffers,
 }
 
@@ -149,7 +152,7 @@ impl<'a> EndObjective<'a> {
         sized(&mut b.ta, k * c * 6);
         sized(&mut b.kta, k * c * 6);
         sized(&mut b.g, k * c * c);
-        EndObjective { frame, kind, scale, b }
+        EndObjective { frame, kind, scale, gradient_only: false, b }
     }
 
     /// Factor `A(x)` and form `Y`, `C_x`, `K_x`; `None` where `A` is not positive definite or
@@ -230,6 +233,9 @@ impl<'a> EndObjective<'a> {
                 }
             }
             gradient[a] = trace;
+        }
+        if self.gradient_only {
+            return;
         }
         // L⁻¹ A_a z_j from the span's first row, and Yᵀ A_a z_j over the span.
         for (a, rows) in self.b.supports.iter().enumerate() {
@@ -369,7 +375,9 @@ impl EndObjective<'_> {
         };
         let s = 1.0 / self.scale;
         gradient.iter_mut().for_each(|g| *g *= s);
-        hessian.iter_mut().for_each(|h| *h *= s);
+        if !self.gradient_only {
+            hessian.iter_mut().for_each(|h| *h *= s);
+        }
         value.is_finite().then_some(value * s)
     }
 }
