@@ -69,10 +69,9 @@ impl crate::Planner {
     ) -> Result<Vec<AlongStep>, crate::PlanError> {
         check_rate(rate)?;
         data.forget();
-        let change = rate.map(|r| r.max_change());
         let mut out = Vec::with_capacity(steps.len());
         for step in steps {
-            out.push(self.next_step(data, step, objective, requirements, settings, change));
+            out.push(self.replan(data, step, objective, requirements, settings, rate)?);
         }
         Ok(out)
     }
@@ -99,29 +98,16 @@ impl crate::Planner {
     ) -> Result<AlongStep, crate::PlanError> {
         check_rate(rate)?;
         let change = rate.map(|r| r.max_change());
-        Ok(self.next_step(data, step, objective, requirements, settings, change))
-    }
-
-    /// A step warm-started from the last plan in `data`; after a step without a plan the next
-    /// starts cold.
-    fn next_step(
-        &self,
-        data: &mut crate::PlannerData,
-        step: &Step,
-        objective: crate::Objective,
-        requirements: &crate::Requirements,
-        settings: &crate::PlanSettings,
-        change: Option<f64>,
-    ) -> AlongStep {
         let result =
             self.plan_step(data, &step.q, &step.f0, objective, requirements, settings, change);
-        match result {
+        Ok(match result {
             Ok((plan, warm, iterations)) => AlongStep { plan: Ok(plan), warm, iterations },
+            // A step without a plan: the next starts cold.
             Err(e) => {
                 data.previous = None;
                 AlongStep { plan: Err(e), warm: false, iterations: 0 }
             }
-        }
+        })
     }
 }
 

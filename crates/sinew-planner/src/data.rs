@@ -7,6 +7,7 @@ use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
 
 use crate::active;
 use crate::bundle::Linear;
+use crate::error::PlanError;
 use crate::frame::Frame;
 use crate::least::LeastEigen;
 use crate::pencil::Pencil;
@@ -62,12 +63,12 @@ impl PlannerData {
 
     /// The buffers of a plan that ends in an error back into the workspace, with its set, so
     /// that the next plan finds them: the error.
-    pub(crate) fn keep<E>(
+    pub(crate) fn keep(
         &mut self,
         (frame, warm, pencil, rows): Taken,
         set: EquilibriumSet,
-        error: E,
-    ) -> E {
+        error: PlanError,
+    ) -> PlanError {
         self.frame = Some(frame);
         self.warm = warm;
         self.pencil = Some(pencil);
