@@ -348,13 +348,10 @@ impl EquilibriumSet {
     pub fn joint_motion(&self, w: &[f64]) -> Vec<f64> {
         let mut motion = vec![0.0; self.dof];
         for b in &self.blocks {
-            for (k, &d) in b.dofs.iter().enumerate() {
-                motion[d] = b
-                    .cables
-                    .iter()
-                    .enumerate()
-                    .map(|(r, &c)| b.pseudo_inverse[(k, r)] * w.get(c).copied().unwrap_or(0.0))
-                    .sum();
+            let on_block: Vec<f64> =
+                b.cables.iter().map(|&c| w.get(c).copied().unwrap_or(0.0)).collect();
+            for (&d, v) in b.dofs.iter().zip(b.motion(&on_block)) {
+                motion[d] = v;
             }
         }
         motion

@@ -22,13 +22,14 @@ use std::ops::Range;
 use faer::{Mat, MatRef};
 
 use crate::error::StaticsError;
-use crate::three_cable::{Share, Triangular, three_cable_joint, triangular};
+use crate::three_cable::{Share, Triangular, three_cable_joint, triangular, triangular_motion};
 
 /// A singular value of `J_c` below this fraction of the largest counts as zero.
 pub const SET_RANK_TOLERANCE: f64 = 1e-10;
 
 /// An independent block of `J_c`: cables that move only these DOFs, DOFs that only these
-/// cables move, with `J⁺` (DOFs × cables), `J` on its numerical range (cables × DOFs), and the
+/// cables move, with `J⁺` (DOFs × cables; for the routed closed form, empty and
+/// `by_substitution`: see [`Block::motion`]), `J` on its numerical range (cables × DOFs), and the
 /// block's share of the set: `f_p` on its cables and its columns of `N` (cables × columns), all
 /// in the block's order of cables.
 #[derive(Debug, PartialEq)]
@@ -39,6 +40,8 @@ pub(crate) struct Block {
     pub(crate) range: Mat<f64>,
     pub(crate) particular: Vec<f64>,
     pub(crate) null: Mat<f64>,
+    /// `J⁺ w` by forward substitution on `range` ([`triangular_motion`]), not `pseudo_inverse`.
+    pub(crate) by_substitution: bool,
 }
 
 impl Clone for Block {
@@ -50,6 +53,7 @@ impl Clone for Block {
             range: self.range.clone(),
             particular: self.particular.clone(),
             null: self.null.clone(),
+            by_substitution: self.by_substitution,
         }
     }
 
@@ -61,6 +65,7 @@ impl Clone for Block {
         copy_matrix(&mut self.range, &source.range);
         self.particular.clone_from(&source.particular);
         copy_matrix(&mut self.null, &source.null);
+        self.by_substitution = source.by_substitution;
     }
 }
 
@@ -95,6 +100,7 @@ impl Block {
             range: Mat::new(),
             particular: Vec::new(),
             null: Mat::new(),
+            by_substitution: false,
         }
     }
 
@@ -112,6 +118,7 @@ impl Block {
         scratch: &mut BlockScratch,
     ) -> Result<(), StaticsError> {
         let (m, d) = (self.cables.len(), self.dofs.len());
+        self.by_substitution = false;
         if m == 0 {
             // DOFs no cable moves: no share of the set (the set's residual check names them).
             self.particular.clear();
@@ -148,7 +155,33 @@ impl Block {
     /// [`triangular`] on this block's `range` into its share.
     fn closed_chain(&mut self, groups: &[Range<usize>], t: &[f64], s: &mut Triangular) -> bool {
         let (j, dofs, out) = self.parts();
-        triangular((j, dofs), groups, t, s, out)
+        let closed = triangular((j, dofs), groups, t, s, out);
+        self.by_substitution = closed;
+        closed
+    }
+
+    /// `J⁺ w` on the block: the joint motion (on its DOFs, in their order) whose cable length
+    /// changes are the part of `w` (on its cables, in their order) in the range of `J`. By the
+    /// stored `J⁺`, or for the routed closed form by forward substitution on `w − N Nᵀ w`.
+    pub(crate) fn motion(&self, w: &[f64]) -> Vec<f64> {
+        let (m, d) = (self.cables.len(), self.dofs.len());
+        let mut out = vec![0.0; d];
+        if self.by_substitution {
+            let mut projected = w.to_vec();
+            for i in 0..self.null.ncols() {
+                let along: f64 = (0..m).map(|c| self.null[(c, i)] * w[c]).sum();
+                projected.iter_mut().enumerate().for_each(|(c, x)| *x -= along * self.null[(c, i)]);
+            }
+            if triangular_motion(self.range.as_ref(), &projected, &mut out) {
+                return out;
+            }
+        }
+        for (k, v) in out.iter_mut().enumerate() {
+            *v = (0..m.min(self.pseudo_inverse.ncols()))
+                .map(|r| self.pseudo_inverse[(k, r)] * w[r])
+                .sum();
+        }
+        out
     }
 
     /// The block's submatrix of `J_c`, its DOFs, and its share to write.
@@ -346,10 +379,13 @@ mod triangular_tests {
                 assert!(u[3 * (l + 1)..].iter().all(|v| *v == 0.0), "column {l} beyond joint {l}");
                 assert!(u[3 * l..3 * l + 3].iter().sum::<f64>() > 0.0);
             }
-            let largest = pinv.norm_max();
-            for d in 0..dof {
-                for c in 0..m {
-                    let (x, y) = (pinv[(d, c)], svd.pseudo_inverse[(d, c)]);
+            // J⁺ on demand, column by column (J⁺ e_c), against the SVD's.
+            assert!(closed.by_substitution && pinv.nrows() == 0, "no J⁺ formed");
+            let largest = svd.pseudo_inverse.norm_max();
+            for c in 0..m {
+                let unit: Vec<f64> = (0..m).map(|r| if r == c { 1.0 } else { 0.0 }).collect();
+                for (d, x) in closed.motion(&unit).into_iter().enumerate() {
+                    let y = svd.pseudo_inverse[(d, c)];
                     assert!((x - y).abs() <= tolerance * largest, "J⁺[{d},{c}] {x} against {y}");
                 }
             }

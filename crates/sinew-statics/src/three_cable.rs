@@ -15,9 +15,11 @@
 //! `null(J_cᵀ)`; the `v_j` are independent (triangular) and there are `m − dof` of them, so
 //! Gram–Schmidt (twice) in the order `j = 0, 1, …` gives an orthonormal `N` whose column `j`
 //! lives on the cables of joints `0..=j`: the block-triangular basis built from the tip. Then
-//! `f_p = f* − N Nᵀ f*` for the back-substituted `f*` of `r = −t`, and `(J_cᵀ)⁺` the same
-//! projection of the back-substituted unit torques. Taken when every joint's own block passes
-//! the single joint's conditioning test; anything else goes to the SVD.
+//! `f_p = f* − N Nᵀ f*` for the back-substituted `f*` of `r = −t`. `J_c⁺` is not formed: `J_c`
+//! is block lower triangular with the blocks `B_l` on its diagonal, so `J_c⁺ w` comes on demand
+//! by forward substitution from the base on `w − N Nᵀ w` ([`triangular_motion`]). Taken when
+//! every joint's own block passes the single joint's conditioning test; anything else goes to
+//! the SVD.
 
 use std::ops::Range;
 
@@ -59,7 +61,8 @@ fn joint_pieces(a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [[f64; 2]; 3])> {
 }
 
 /// A block's share of the equilibrium set, written by the closed forms: `f_p` on its cables,
-/// its columns of `N` (cables × columns) and `J⁺` (DOFs × cables), in the block's order.
+/// its columns of `N` (cables × columns) and `J⁺` (DOFs × cables; empty where it comes on
+/// demand), in the block's order.
 pub(crate) struct Share<'a> {
     pub(crate) particular: &'a mut Vec<f64>,
     pub(crate) null: &'a mut Mat<f64>,
@@ -103,9 +106,44 @@ pub(crate) struct Triangular {
     column: Vec<f64>,
 }
 
+impl Triangular {
+    /// Each cable's joint (that of its last non-zero DOF of `j`, cables × DOFs with two DOFs
+    /// per joint) and each joint's own `n` and `(B_lᵀ)⁺`; `false` unless three cables end at
+    /// every joint and each joint's own block has the closed form.
+    fn chain_pieces(&mut self, j: MatRef<'_, f64>) -> bool {
+        let (m, dof) = (j.nrows(), j.ncols());
+        let joints = dof / 2;
+        // Each cable's joint: that of its last non-zero DOF; three per joint.
+        self.ends.clear();
+        self.ends.resize(joints, [0; 3]);
+        self.counts.clear();
+        self.counts.resize(joints, 0);
+        for c in 0..m {
+            let Some(last) = (0..dof).rev().find(|&d| j[(c, d)] != 0.0) else { return false };
+            let l = last / 2;
+            if self.counts[l] == 3 {
+                return false;
+            }
+            self.ends[l][self.counts[l]] = c;
+            self.counts[l] += 1;
+        }
+        if self.counts.iter().any(|&n| n != 3) {
+            return false;
+        }
+        self.pieces.clear();
+        for (l, cables) in self.ends.iter().enumerate() {
+            let column = |d: usize| cables.map(|c| j[(c, 2 * l + d)]);
+            let Some(pieces) = joint_pieces(column(0), column(1)) else { return false };
+            self.pieces.push(pieces);
+        }
+        true
+    }
+}
+
 /// The routed arm's block-triangular closed form (module docs) of the block `j` (cables ×
 /// DOFs, its `dofs` global) under the torques `t` (on the block's DOFs), with the arm's joints
-/// `groups`: `f_p`, `N`'s columns and `J⁺` into `out`; `false` (`out` untouched) when the block
+/// `groups`: `f_p` and `N`'s columns into `out`, its `J⁺` left empty (on demand by
+/// [`triangular_motion`]); `false` (`out` untouched) when the block
 /// does not have the shape (two DOFs per joint, three cables ending at each) or a joint's own
 /// block is too close to rank 1.
 pub(crate) fn triangular(
@@ -127,28 +165,8 @@ pub(crate) fn triangular(
             return false;
         }
     }
-    // Each cable's joint: that of its last non-zero DOF; three per joint.
-    s.ends.clear();
-    s.ends.resize(joints, [0; 3]);
-    s.counts.clear();
-    s.counts.resize(joints, 0);
-    for c in 0..m {
-        let Some(last) = (0..dof).rev().find(|&d| j[(c, d)] != 0.0) else { return false };
-        let l = last / 2;
-        if s.counts[l] == 3 {
-            return false;
-        }
-        s.ends[l][s.counts[l]] = c;
-        s.counts[l] += 1;
-    }
-    if s.counts.iter().any(|&n| n != 3) {
+    if !s.chain_pieces(j) {
         return false;
-    }
-    s.pieces.clear();
-    for (l, cables) in s.ends.iter().enumerate() {
-        let column = |d: usize| cables.map(|c| j[(c, 2 * l + d)]);
-        let Some(pieces) = joint_pieces(column(0), column(1)) else { return false };
-        s.pieces.push(pieces);
     }
     let (ends, pieces) = (&s.ends, &s.pieces);
     // J_cᵀ f = r on the joints before `from`, from the tip down, with f already set on the
@@ -206,23 +224,33 @@ pub(crate) fn triangular(
     solve(&s.rhs, joints, joints - 1, &mut s.column);
     project(&mut s.column);
     out.particular.clone_from(&s.column);
-    out.pseudo_inverse.resize_with(dof, m, |_, _| 0.0);
-    for d in 0..dof {
-        s.rhs.fill(0.0);
-        s.rhs[d] = 1.0;
-        s.column.fill(0.0);
-        // A unit torque at joint d / 2 leaves the cables of the joints beyond it at zero: the
-        // back-substitution starts at its own joint.
-        solve(&s.rhs, d / 2 + 1, d / 2, &mut s.column);
-        project(&mut s.column);
-        for (c, v) in s.column.iter().enumerate() {
-            out.pseudo_inverse[(d, c)] = *v;
-        }
-    }
+    // `J⁺` on demand ([`triangular_motion`]): no matrix here.
+    out.pseudo_inverse.resize_with(0, 0, |_, _| 0.0);
     out.null.resize_with(m, joints, |_, _| 0.0);
     for (i, u) in null.chunks_exact(m).enumerate() {
         for (c, v) in u.iter().enumerate() {
             out.null[(c, i)] = *v;
+        }
+    }
+    true
+}
+
+/// `J⁺ w` of a block that [`triangular`] took, `j` its submatrix of `J_c` (cables × DOFs) and
+/// `w` (on its cables) already projected onto the range of `j` (`w − N Nᵀ w`): the joint
+/// motion `δq` (into `out`, dof) with `j δq = w`, by forward substitution from the base. The
+/// cables of joint `l` move only the joints up to `l`, so `δq_l = B_l⁺ (w_l − Σ_{l' < l}
+/// J_{l l'} δq_{l'})` with `B_l⁺ = ((B_lᵀ)⁺)ᵀ`, a left inverse of the joint's own block; the
+/// system is consistent and `j` has full column rank, so this is the least-squares solution
+/// `J⁺ w`. `false` (`out` untouched) when `j` does not have the shape.
+pub(crate) fn triangular_motion(j: MatRef<'_, f64>, w: &[f64], out: &mut [f64]) -> bool {
+    let mut s = Triangular::default();
+    if j.ncols() % 2 != 0 || j.nrows() != 3 * j.ncols() / 2 || !s.chain_pieces(j) {
+        return false;
+    }
+    for (l, (cables, (_, inverse))) in s.ends.iter().zip(&s.pieces).enumerate() {
+        let rest = cables.map(|c| w[c] - (0..2 * l).map(|d| j[(c, d)] * out[d]).sum::<f64>());
+        for d in 0..2 {
+            out[2 * l + d] = (0..3).map(|row| inverse[row][d] * rest[row]).sum();
         }
     }
     true
