@@ -71,6 +71,8 @@ const STATIONARY: f64 = 1e-9;
 pub(crate) struct WarmWork {
     /// The mapped previous answer `x₀` (filled by the caller).
     pub(crate) mapped: Vec<f64>,
+    /// The predicted tensions that `mapped` maps (the caller's).
+    pub(crate) predicted: Vec<f64>,
     /// The iterate (moved into the answer; the caller returns it).
     pub(crate) x: Vec<f64>,
     /// A forgotten plan's tensions' buffer (`PlannerData::forget`), for the next plan's.

@@ -18,6 +18,10 @@ pub struct PlannerData {
     pub(crate) stiffness: ArmStiffnessData,
     /// The last plan's tensions, for a rate limit and a warm start along a trajectory.
     pub(crate) previous: Option<Vec<f64>>,
+    /// The tensions of the plan before the last, where the last was a step after it along a
+    /// trajectory (the flag; the buffer is kept either way): with the last, the warm start's
+    /// predicted tensions `2 f_k − f_{k−1}` (module docs of `along.rs`).
+    pub(crate) before: (bool, Vec<f64>),
     /// The last interior-point plan's active rows, with the number of rows of its frame (the
     /// warm start's first active set when this frame has as many).
     pub(crate) active: Option<(usize, Vec<usize>)>,
@@ -44,6 +48,7 @@ impl PlannerData {
         PlannerData {
             stiffness: ArmStiffnessData::new(arm),
             previous: None,
+            before: (false, Vec::new()),
             active: None,
             pencil: None,
             margin: (Vec::new(), LeastEigen::default()),
@@ -58,6 +63,7 @@ impl PlannerData {
     /// plan is cold and depends on its own arguments only.
     pub(crate) fn forget(&mut self) {
         self.margin.1.forget();
+        self.before.0 = false;
         self.warm.forget(self.previous.take());
     }
 

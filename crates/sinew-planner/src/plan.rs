@@ -19,7 +19,8 @@ use crate::pencil::Pencil;
 use crate::phases::{Problem, pencil_scale};
 use crate::problem::{Method, Objective, Plan, PlanSettings, Requirements, check_inputs};
 use crate::rows::{
-    HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows_into, rate_error, rate_rows,
+    HeldTensions, column_sums, fix_rows, held_coordinates, linear_rows_into, predicted, rate_error,
+    rate_rows,
 };
 
 /// The planner's model: the arm (robot, routing, statics). Immutable; one [`PlannerData`] per
@@ -150,7 +151,9 @@ impl Planner {
                 let taken = data.active.take();
                 let active = taken.as_ref().filter(|(n, _)| *n == rows).map(|(_, a)| &a[..]);
                 let mut work = std::mem::take(&mut data.warm);
+                let before = data.before.0.then_some(&data.before.1[..]);
                 let attempt = previous.as_ref().map(|f| {
+                    let f = predicted(&set, f, before, &mut work.predicted);
                     frame.x_of_tensions(&set, f, &mut work.mapped);
                     interior::warm(&frame, objective, requirements, settings, active, &mut work)
                 });
@@ -206,7 +209,11 @@ impl Planner {
         data.pencil = Some(pencil);
         data.rows = Some((linear, merged, keys));
         let plan = self.answer(data, &set, objective, requirements, lambda, upper, iterations)?;
-        // The tensions into the last ones' buffer.
+        // The last tensions into the buffer of those before them, these into the last ones'.
+        data.before.0 = previous.is_some();
+        if let Some(previous) = &previous {
+            data.before.1.clone_from(previous);
+        }
         let mut kept = previous.unwrap_or_else(|| std::mem::take(&mut data.warm.tensions));
         kept.clone_from(&plan.tensions);
         data.previous = Some(kept);

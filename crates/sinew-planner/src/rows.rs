@@ -99,10 +99,71 @@ pub(crate) fn rate_rows(set: &EquilibriumSet, previous: &[f64], change: f64, lin
     }
 }
 
+/// The warm start's tensions from the last plan's `last` and, where it was a step along the
+/// same trajectory, the one's before it, `before`: the linear prediction `2 f_k − f_{k−1}`
+/// within the tension limits (into `out`), whose error along a smooth trajectory is second
+/// order in the time step where the last tensions' is first order; `last` itself without
+/// `before`.
+pub(crate) fn predicted<'a>(
+    set: &EquilibriumSet,
+    last: &'a [f64],
+    before: Option<&[f64]>,
+    out: &'a mut Vec<f64>,
+) -> &'a [f64] {
+    let Some(before) = before.filter(|b| b.len() == last.len()) else { return last };
+    out.clear();
+    out.extend(last.iter().zip(before).map(|(f, b)| 2.0 * f - b));
+    for (f, (lo, hi)) in out.iter_mut().zip(set.lower().iter().zip(set.upper())) {
+        *f = f.clamp(*lo, *hi);
+    }
+    out
+}
+
 /// With a rate limit, rows that no point meets are the limit's doing (or the budgets').
 pub(crate) fn rate_error(error: PlanError, limited: bool) -> PlanError {
     match error {
         PlanError::BudgetsInfeasible if limited => PlanError::RateLimitInfeasible,
         e => e,
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use nalgebra::Vector6;
+    use sinew_routing::PatternModel;
+    use sinew_stiffness::{ArmStiffness, ArmStiffnessData};
+    use sinew_testkit::cdhrm5;
+
+    use super::predicted;
+
+    #[test]
+    fn the_prediction_is_the_linear_extrapolation_within_the_limits() {
+        let (robot, routing) = cdhrm5::robot_and_routing(PatternModel::Routed);
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let mut sd = ArmStiffnessData::new(&arm);
+        let f0 = Vector6::new(0.0, 5.0, 0.0, 0.0, 0.0, 0.0);
+        arm.set_pose(&mut sd, &cdhrm5::LOADED_POSE, &f0).unwrap();
+        let set = arm.equilibrium_set(&mut sd).unwrap();
+        let (lower, upper) = (set.lower(), set.upper());
+        let m = set.cable_count();
+        // Inside the limits, except cable 0 driven above its upper one and cable 1 below its
+        // lower one.
+        let middle = |c: usize| 0.5 * (lower[c] + upper[c]);
+        let last: Vec<f64> = (0..m).map(|c| middle(c) + 0.01 * c as f64).collect();
+        let mut before: Vec<f64> = (0..m).map(|c| middle(c) - 0.02 * c as f64).collect();
+        before[0] = last[0] - upper[0];
+        before[1] = last[1] + upper[1];
+        let mut out = Vec::new();
+        let got = predicted(set, &last, Some(&before), &mut out).to_vec();
+        assert_eq!(got[0], upper[0]);
+        assert_eq!(got[1], lower[1]);
+        for c in 2..m {
+            assert_eq!(got[c], 2.0 * last[c] - before[c], "cable {c}");
+            assert!(got[c] > last[c], "cable {c}: along the motion");
+        }
+        // Without the tensions before (or with another arm's), the last ones.
+        assert_eq!(predicted(set, &last, None, &mut out), &last[..]);
+        assert_eq!(predicted(set, &last, Some(&before[1..]), &mut out), &last[..]);
     }
 }
