@@ -130,11 +130,9 @@ pub fn dead_band(
     sizes(&[("anchor tensions", m, anchor.len()), ("dead band", m, out.len())])?;
     let mu = model.friction_coefficients();
     for (c, (&t_a, out)) in anchor.iter().zip(out.iter_mut()).enumerate() {
-        let (mut pull, mut release) = (1.0, 1.0);
-        for &theta in data.wrap_angles(model, c)? {
-            pull *= (-mu[c] * theta).exp();
-            release *= (mu[c] * theta).exp();
-        }
+        // Π_k e^{σμθ_k} = e^{σμ Σ_k θ_k}: two exponentials per cable, not two per hole.
+        let wrap: f64 = data.wrap_angles(model, c)?.iter().sum();
+        let (pull, release) = ((-mu[c] * wrap).exp(), (mu[c] * wrap).exp());
         *out = [t_a / release, t_a / pull];
     }
     Ok(())
