@@ -99,8 +99,9 @@ pub(crate) fn rate_rows(set: &EquilibriumSet, previous: &[f64], change: f64, lin
     }
 }
 
-/// The warm start's tensions from the last plan's `last` and, where it was a step along the
-/// same trajectory, the one's before it, `before`: the linear prediction `2 f_k − f_{k−1}`
+/// The warm start's tensions from the last plan's, `last`, and, where that plan was a step
+/// along the same trajectory, the tensions of the plan before it, `before`: the linear
+/// prediction `2 f_k − f_{k−1}`
 /// within the tension limits (into `out`), whose error along a smooth trajectory is second
 /// order in the time step where the last tensions' is first order; `last` itself without
 /// `before`.
