@@ -151,9 +151,10 @@ impl Planner {
                 let taken = data.active.take();
                 let active = taken.as_ref().filter(|(n, _)| *n == rows).map(|(_, a)| &a[..]);
                 let mut work = std::mem::take(&mut data.warm);
-                let before = data.before.0.then_some(&data.before.1[..]);
+                // The tensions before the last, for the warm start's prediction.
+                let earlier = data.before.0.then_some(&data.before.1[..]);
                 let attempt = previous.as_ref().map(|f| {
-                    let f = predicted(&set, f, before, &mut work.predicted);
+                    let f = predicted(&set, f, earlier, &mut work.predicted);
                     frame.x_of_tensions(&set, f, &mut work.mapped);
                     interior::warm(&frame, objective, requirements, settings, active, &mut work)
                 });
