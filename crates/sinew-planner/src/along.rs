@@ -7,8 +7,8 @@
 //! step followed another, `f_prev` is the linear prediction `2 f_k − f_{k−1}` within the tension
 //! limits (`rows::predicted`): along a smooth trajectory its error is second order in the time
 //! step, the last tensions' first order (on the bench's routed trajectory: one cold step per
-//! 100 instead of three, and for the volume a Newton step after 66 of 198 warm starts instead
-//! of 118). From there, Newton
+//! 100 instead of three, and for the volume 66 Newton steps over 198 warm steps instead of
+//! 118). From there, Newton
 //! steps on the previous plan's active rows (module docs of `active.rs`: the smooth objectives
 //! and least tension, with the margin not active and no floor). Where those do not apply or are
 //! not certified: when the point is strictly inside the new constraints (else it is moved by
