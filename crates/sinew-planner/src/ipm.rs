@@ -26,10 +26,6 @@ use crate::smooth::{EndObjective, Kind};
 /// start well inside the margin and the floors, not on their boundary.
 const CENTRING: f64 = 0.3;
 
-/// Above this many DOFs the last phase checks the margin lazily ([`Interior::optimise`]): up to
-/// it, the fixed-size kernels make the margin's block cheap.
-pub(crate) const LAZY_MARGIN_DOF: usize = 16;
-
 /// One plan's interior-point problem. Its phases run in an [`IpmWork`] and pass their point on
 /// in its `x`.
 pub(crate) struct Interior<'a> {
@@ -289,13 +285,16 @@ impl<'a> Interior<'a> {
     /// `w.x`. The returned bound is in real units of the maximised objective (`−Σ f`,
     /// `−uᵀ C u` for the minimised ones).
     ///
-    /// Above [`LAZY_MARGIN_DOF`] DOFs the margin is checked lazily, as the margin rarely binds
-    /// where the objective asks for stiffness and its n × n block dominates an iteration: the
-    /// phase first runs without the margin's block, and its answer stands when `A − m I ≻ 0`
+    /// The margin is checked lazily, as it rarely binds where the objective asks for stiffness:
+    /// the phase first runs without the margin's block, and its answer stands when `A − m I ≻ 0`
     /// there (one Cholesky trial). The bound of that run holds for the plan's problem too: it
     /// bounds the optimum over a larger set (the objective is concave on its domain `A ≻ 0`,
     /// which the run never leaves: its steps are halved where they would). Otherwise the phase
-    /// runs again from `x` with the block, and both runs' iterations count.
+    /// runs again from `x` with the block, and both runs' iterations count. Without the block
+    /// an iteration is cheaper and the central path is not bent by the margin's barrier:
+    /// cdhrm5's cold stiffness plans take 6–11 iterations instead of 9–13 and 40–62 % fewer
+    /// instructions (docs/performance.md, session 17). A least-tension plan is where the margin
+    /// binds (cdhrm5 decoupled at the default margin): there the first run is spent, 10 % more.
     ///
     /// # Errors
     /// [`PlanError::NoEndStiffness`]; [`PlanError::NotConverged`].
@@ -304,9 +303,6 @@ impl<'a> Interior<'a> {
         w: &mut IpmWork,
         max_iterations: usize,
     ) -> Result<Last, PlanError> {
-        if self.frame.n <= LAZY_MARGIN_DOF {
-            return self.optimise_blocks(w, max_iterations, false);
-        }
         w.from.clone_from(&w.x);
         let spent = match self.optimise_blocks(w, max_iterations, true) {
             Ok(last) if margin_exceeds(self.frame, &w.x, self.requirements.margin, &mut w.a) => {
