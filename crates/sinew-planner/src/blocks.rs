@@ -161,14 +161,27 @@ pub(crate) fn floor_block(
     // with wide spans among them (routed), the unfactored pairs cost more than before. (The
     // factors are allocated per block: only above the fixed-size kernels.)
     let factored = p > FACTORED_ABOVE && f.spans.iter().all(|s| s.len() <= FACTORED_SPAN);
-    b.factors = factored.then(|| Factors {
-        basis: r.to_vec(),
-        q: n,
-        small: (0..b.coefficients.len())
+    b.factors = factored.then(|| {
+        // The basis `R` (n × p) and below it `P = J_p R` (3 × p): the epigraph's coefficient
+        // `−t s Rᵀ J_pᵀ K J_p R = Pᵀ (−t s K) P` is then factored too, on the rows n..n+3 (its
+        // Schur terms 3 × 3 forms instead of five p × p products an iteration).
+        let mut basis = Vec::with_capacity((n + 3) * p);
+        basis.extend_from_slice(&r[..n * p]);
+        for i in 0..3 {
+            for c in 0..p {
+                basis.push((0..n).map(|a| f.j_x[i * n + a] * r[a * p + c]).sum());
+            }
+        }
+        let mut small: Vec<_> = (0..b.coefficients.len())
             .map(|a| {
                 f.spans.get(a).map(|span| (span.clone(), f.ai[a].iter().map(|v| v * s).collect()))
             })
-            .collect(),
+            .collect();
+        if let (Err(t_scale), Some(slot)) = (tau, small.get_mut(f.vars())) {
+            let k = (0..9).map(|e| -t_scale * s * floor.k[(e / 3, e % 3)]).collect();
+            *slot = Some((n..n + 3, k));
+        }
+        Factors { basis, q: n + 3, small }
     });
 }
 

@@ -38,8 +38,9 @@ pub(crate) struct Block {
 
 /// Coefficients `F_a = R_aᵀ B_a R_a`, `R_a` the rows `span_a` of a basis `R` (q × n,
 /// row-major) and `B_a` symmetric, |span_a| × |span_a|: a floor's `Rᵀ A_a R` with `A_a` one
-/// joint's 2 × 2 block. With them the Schur terms need `R Z Rᵀ` and `R S⁻¹ Rᵀ` once an
-/// iteration, not two n × n products per coefficient (`block_work.rs`).
+/// joint's 2 × 2 block, or the epigraph's `Pᵀ B P` on three rows `P = J_p R` appended below
+/// the DOFs' (so `q` is the DOFs plus 3). With them the Schur terms need `R Z Rᵀ` and
+/// `R S⁻¹ Rᵀ` once an iteration, not two n × n products per coefficient (`block_work.rs`).
 #[derive(Debug, Clone)]
 pub(crate) struct Factors {
     pub(crate) basis: Vec<f64>,
