@@ -323,7 +323,8 @@ fn steps(
                 axpy(eta, &margin.gradient, bound_gradient);
             }
             let duals = Duals { y: std::mem::take(y), ..Duals::default() };
-            let upper = upper_bound(sdp, x, bound_value, bound_gradient, s, empty(), &duals);
+            let none = |_, _| None;
+            let upper = upper_bound(sdp, x, bound_value, bound_gradient, s, empty(), &duals, none);
             *y = duals.y;
             if upper - value <= tolerance {
                 let x = std::mem::take(x);

@@ -4,7 +4,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::frame::{Frame, congruence};
+use crate::frame::{Frame, congruence, span_congruence};
 use crate::program::Factors;
 use crate::sdp::{Block, Sdp};
 
@@ -25,12 +25,11 @@ pub(crate) struct Floor {
 /// The scratch of [`floor_block`], kept between blocks.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
-    q: Vec<f64>,
+    /// `P = J_p R` (3 × p).
+    jp: Vec<f64>,
     d: Vec<f64>,
     b0: Vec<f64>,
-    dense: Vec<f64>,
-    rows: Vec<usize>,
-    mr: Vec<f64>,
+    t: Vec<f64>,
 }
 
 /// The base problem: the rows (with `extra` zero columns) and the box, no block.
@@ -112,27 +111,28 @@ pub(crate) fn floor_block(
     (b, scratch): (&mut Block, &mut Scratch),
 ) {
     let (n, p) = (f.n, f.n - 3);
-    let Scratch { q, d, b0, dense, rows, mr } = scratch;
-    // Q = J_pᵀ K J_p (n × n).
-    q.clear();
-    q.resize(n * n, 0.0);
-    for a in 0..n {
-        for c in 0..n {
-            let mut v = 0.0;
-            for i in 0..3 {
-                for j in 0..3 {
-                    v += f.j_x[i * n + a] * floor.k[(i, j)] * f.j_x[j * n + c];
-                }
-            }
-            q[a * n + c] = v;
+    let Scratch { jp, d, b0, t } = scratch;
+    // P = J_p R (3 × p), then D = Rᵀ J_pᵀ K J_p R = Pᵀ K P (its lower triangle, mirrored).
+    jp.clear();
+    for i in 0..3 {
+        for c in 0..p {
+            jp.push((0..n).map(|a| f.j_x[i * n + a] * r[a * p + c]).sum());
         }
     }
     for m in [&mut *d, &mut *b0] {
         m.clear();
         m.resize(p * p, 0.0);
     }
-    congruence(q, r, (n, p), (rows, mr), d);
-    congruence(&f.a0, r, (n, p), (rows, mr), b0);
+    for a in 0..p {
+        let kp: [f64; 3] =
+            std::array::from_fn(|j| (0..3).map(|i| jp[i * p + a] * floor.k[(i, j)]).sum());
+        for c in 0..=a {
+            let v = (0..3).map(|j| kp[j] * jp[j * p + c]).sum();
+            d[a * p + c] = v;
+            d[c * p + a] = v;
+        }
+    }
+    congruence(&f.a0, r, (n, p), t, b0);
     let scale = (0..p).map(|i| b0[i * p + i].abs()).fold(0.0, f64::max).max(1e-300);
     let s = 1.0 / scale;
     let fixed = tau.unwrap_or(0.0);
@@ -141,11 +141,8 @@ pub(crate) fn floor_block(
         *c = (v - fixed * dd) * s;
     }
     for a in 0..f.vars() {
-        dense.clear();
-        dense.resize(n * n, 0.0);
-        f.add_ai(a, s, dense, n);
         let mut e = b.fresh(p * p);
-        congruence(dense, r, (n, p), (rows, mr), &mut e);
+        span_congruence((&f.ai[a], f.spans[a].clone(), s), r, p, t, &mut e);
         b.coefficients[a] = Some(e);
     }
     if let Err(t_scale) = tau {
@@ -167,11 +164,7 @@ pub(crate) fn floor_block(
         // Schur terms 3 × 3 forms instead of five p × p products an iteration).
         let mut basis = Vec::with_capacity((n + 3) * p);
         basis.extend_from_slice(&r[..n * p]);
-        for i in 0..3 {
-            for c in 0..p {
-                basis.push((0..n).map(|a| f.j_x[i * n + a] * r[a * p + c]).sum());
-            }
-        }
+        basis.extend_from_slice(jp);
         let mut small: Vec<_> = (0..b.coefficients.len())
             .map(|a| {
                 f.spans.get(a).map(|span| (span.clone(), f.ai[a].iter().map(|v| v * s).collect()))

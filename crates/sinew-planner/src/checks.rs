@@ -42,6 +42,15 @@ fn fill(
     Frame::new(pencil, &set, &linear_rows(&set, None, &[]).merged(), &[])
 }
 
+/// The frame of a 12-joint weightless chain (24 DOFs) under a small tip force.
+fn chain12() -> Frame {
+    let (robot, routing) = cdhrm5::chain(12, PatternModel::Decoupled);
+    let robot = robot.with_gravity(nalgebra::Vector3::zeros());
+    let q: Vec<f64> = (0..24).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
+    let f0 = Vector6::new(0.0, 0.1, 0.05, 0.0, 0.0, 0.0);
+    fill(&robot, &routing, &q, &f0, &mut crate::pencil::Pencil::empty())
+}
+
 /// Random points strictly inside the rows with `A(x) ≻ margin I`.
 fn stable_points(f: &Frame, margin: f64, count: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -311,19 +320,14 @@ fn a_refilled_pencil_is_a_fresh_one() {
 /// The Schur terms of a stiffness floor's block from its factored coefficients
 /// (`R_aᵀ B_a R_a`: `block_work::add_factored_schur`) are those of its dense ones, for random
 /// `Z ⪰ 0` and the block's own `S⁻¹`, with and without an epigraph coefficient (factored and
-/// unfactored pairs). A wrong entry of `G_d`, `W` or `V` (its diagonal only, another joint's
-/// rows) fails it.
+/// unfactored pairs), and so are its dual terms `⟨Z, F_a⟩` (`block_work::factored_dual_term`).
+/// A wrong entry of `G_d`, `W` or `V` (its diagonal only, another joint's rows) fails it.
 #[test]
 fn a_floors_factored_schur_terms_are_its_dense_ones() {
-    use crate::block_work::{BlockWork, add_block_schur};
+    use crate::block_work::{BlockWork, add_block_schur, dual_congruence, factored_dual_term};
     use crate::blocks::{Floor, Scratch, floor_block};
-    // A 12-joint weightless chain under a small tip force: 24 DOFs, a 21 × 21 floor, above
-    // the fixed-size kernels (below them the floor is not factored).
-    let (robot, routing) = cdhrm5::chain(12, PatternModel::Decoupled);
-    let robot = robot.with_gravity(nalgebra::Vector3::zeros());
-    let q: Vec<f64> = (0..24).map(|i| 0.1 * ((i as f64) * 1.3).sin()).collect();
-    let f0 = Vector6::new(0.0, 0.1, 0.05, 0.0, 0.0, 0.0);
-    let f = fill(&robot, &routing, &q, &f0, &mut crate::pencil::Pencil::empty());
+    // 24 DOFs, a 21 × 21 floor, above the fixed-size kernels (below them it is not factored).
+    let f = chain12();
     let r = f.rotation_null_basis().unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let x = stable_points(&f, 0.0, 1, 5).remove(0);
@@ -349,7 +353,19 @@ fn a_floors_factored_schur_terms_are_its_dense_ones() {
             w.s_inv = (0..n * n).map(|e| s_inv[(e / n, e % n)]).collect();
             let kk = f.vars() + 1;
             let mut out = vec![0.0; kk * kk];
+            dual_congruence(block, &z, &mut w);
             add_block_schur(block, &z, &mut w, kk, &mut out);
+            for (a, fa) in block.coefficients.iter().enumerate() {
+                let Some(fa) = fa else { continue };
+                let known = factored_dual_term(block, &w, a);
+                assert_eq!(known.is_some(), block.factors.is_some(), "{tau:?}: coefficient {a}");
+                let dense = crate::dense::inner(fa, &z);
+                let error = (known.unwrap_or(dense) - dense).abs();
+                assert!(
+                    error <= 1e-12 * (1.0 + dense.abs()),
+                    "{tau:?}: ⟨Z, F_{a}⟩ off by {error:e}"
+                );
+            }
             out
         };
         let (a, d) = (schur(&factored), schur(&dense));
@@ -391,5 +407,27 @@ fn the_margin_row_is_the_least_eigenvalue_of_the_frames_pencil() {
         }
         println!("{model:?}: margin gradient error {worst:.1e}");
         assert!(worst <= 5e-8, "{model:?}: margin gradient error {worst:e}");
+    }
+}
+
+/// The basis `R` of `null(J_r)` on both cdhrm5 frames and the 24-DOF chain: orthonormal and
+/// annihilated by `J_r` to rounding; refused when `J_r` loses rank (one rotation row a
+/// combination of the other two, or zero). A reflection applied in the wrong order, or one
+/// missing, fails the first; a wrong rank test fails the second.
+#[test]
+fn the_rotation_null_basis_is_orthonormal_and_in_the_null_space() {
+    for mut f in cdhrm5::MODELS.into_iter().map(frame).chain([chain12()]) {
+        let (n, p) = (f.n, f.n - 3);
+        let r = DMatrix::from_row_slice(n, p, &f.rotation_null_basis().unwrap());
+        let j_r = DMatrix::from_row_slice(3, n, &f.j_x[3 * n..6 * n]);
+        let orthonormal = (r.transpose() * &r - DMatrix::identity(p, p)).abs().max();
+        let null = (&j_r * &r).abs().max() / j_r.abs().max();
+        assert!(orthonormal <= 1e-14 && null <= 1e-14, "n = {n}: {orthonormal:e}, {null:e}");
+        let row: Vec<f64> =
+            (0..n).map(|c| 0.3 * f.j_x[3 * n + c] - 2.0 * f.j_x[4 * n + c]).collect();
+        f.j_x[5 * n..6 * n].copy_from_slice(&row);
+        assert!(f.rotation_null_basis().is_none(), "n = {n}: rank 2 accepted");
+        f.j_x[3 * n..4 * n].fill(0.0);
+        assert!(f.rotation_null_basis().is_none(), "n = {n}: a zero row accepted");
     }
 }

@@ -117,12 +117,29 @@ fn cholesky_dynamic(a: &mut [f64], n: usize) -> bool {
             a[j * n + i] = a[i * n + j];
         }
     }
+    whole_dynamic(a, n, true)
+}
+
+/// [`cholesky`] of a matrix stored whole (both triangles, equal: the method's slacks,
+/// multipliers and their steps are). Above the fixed sizes the factorisation reads the
+/// row-major upper triangle, so it needs no mirror first; with `factor` false only the verdict
+/// is wanted (a step length's trial) and the factor is not mirrored into the lower triangle
+/// either (`a` is then spoilt).
+#[inline(always)]
+pub(crate) fn cholesky_whole(a: &mut [f64], n: usize, factor: bool) -> bool {
+    fixed_size!(n, cholesky_fixed(a), whole_dynamic(a, n, factor))
+}
+
+fn whole_dynamic(a: &mut [f64], n: usize, factor: bool) -> bool {
+    let a = &mut a[..n * n];
     if !sinew_stiffness::cholesky_lower_in_place(a, n) {
         return false;
     }
-    for i in 0..n {
-        for j in 0..i {
-            a[i * n + j] = a[j * n + i];
+    if factor {
+        for i in 0..n {
+            for j in 0..i {
+                a[i * n + j] = a[j * n + i];
+            }
         }
     }
     true
@@ -181,14 +198,20 @@ fn cholesky_solve_dynamic(l: &[f64], n: usize, b: &mut [f64]) {
     }
 }
 
-/// `out = (L Lᵀ)⁻¹ = L⁻ᵀ L⁻¹`, full and symmetric (`l` from [`cholesky`]): `T = L⁻¹` row by
-/// row (`T_i = (e_i − Σ_{p<i} L_ip T_p) / L_ii`) into the scratch `t` (n × n), then `Tᵀ T`
-/// as a sum of outer products of its rows.
+/// `S⁻¹ = L⁻ᵀ L⁻¹` into `out` from the factor `L` of [`cholesky`] (`t` n × n scratch), exactly
+/// symmetric. Up to the fixed sizes: `T = L⁻¹` row by row (`T_i = (e_i − Σ_{p<i} L_ip T_p) /
+/// L_ii`), then `Tᵀ T` as a sum of outer products of its rows; above, faer's triangular inverse
+/// and its triangle-aware product (the lower triangle of `Tᵀ T`, mirrored).
 #[inline(always)]
 pub(crate) fn cholesky_inverse(l: &[f64], n: usize, out: &mut [f64], t: &mut [f64]) {
-    fixed_size!(n, lower_inverse_fixed(l, t), lower_inverse_dynamic(l, n, t));
-    gram_of_rows(t, n, out);
-    symmetrise(out, n);
+    fixed_size!(n, inverse_fixed(l, t, out), inverse_dynamic(l, n, out, t));
+}
+
+#[inline(always)]
+fn inverse_fixed<const N: usize>(l: &[f64], t: &mut [f64], out: &mut [f64]) {
+    lower_inverse_fixed::<N>(l, t);
+    gram_of_rows(t, N, out);
+    symmetrise(out, N);
 }
 
 #[inline(always)]
@@ -212,20 +235,21 @@ fn lower_inverse_fixed<const N: usize>(l: &[f64], t: &mut [f64]) {
     }
 }
 
-fn lower_inverse_dynamic(l: &[f64], n: usize, t: &mut [f64]) {
-    let t = &mut t[..n * n];
-    t.fill(0.0);
-    for i in 0..n {
-        let (done, rest) = t.split_at_mut(i * n);
-        let row = &mut rest[..n];
-        for p in 0..i {
-            axpy(-l[i * n + p], &done[p * n..p * n + p + 1], &mut row[..p + 1]);
+fn inverse_dynamic(l: &[f64], n: usize, out: &mut [f64], t: &mut [f64]) {
+    use faer::linalg::matmul::triangular::{BlockStructure, matmul};
+    use faer::{Accum, MatMut, MatRef, Par};
+    let l = MatRef::from_row_major_slice(&l[..n * n], n, n);
+    let mut tm = MatMut::from_row_major_slice_mut(&mut t[..n * n], n, n);
+    faer::linalg::triangular_inverse::invert_lower_triangular(tm.as_mut(), l, Par::Seq);
+    let tr = tm.as_ref();
+    let o = MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
+    let (lower, upper) = (BlockStructure::TriangularLower, BlockStructure::TriangularUpper);
+    matmul(o, lower, Accum::Replace, tr.transpose(), upper, tr, lower, 1.0, Par::Seq);
+    let out = &mut out[..n * n];
+    for r in 0..n {
+        for c in 0..r {
+            out[c * n + r] = out[r * n + c];
         }
-        let inv = 1.0 / l[i * n + i];
-        for v in &mut row[..i] {
-            *v *= inv;
-        }
-        row[i] = inv;
     }
 }
 
@@ -304,146 +328,4 @@ pub(crate) fn inner(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
-mod tests {
-    use super::*;
-    use faer::Mat;
-
-    fn spd(n: usize, seed: u64) -> Vec<f64> {
-        // B Bᵀ + n I with B from a small linear congruential sequence.
-        let mut state = seed;
-        let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let b: Vec<f64> = (0..n * n).map(|_| next()).collect();
-        let mut a = vec![0.0; n * n];
-        for r in 0..n {
-            for c in 0..n {
-                a[r * n + c] = (0..n).map(|p| b[r * n + p] * b[c * n + p]).sum::<f64>()
-                    + if r == c { 0.1 } else { 0.0 };
-            }
-        }
-        a
-    }
-
-    #[test]
-    fn cholesky_matches_faer_and_solves_and_inverts() {
-        for (n, seed) in [(1, 1), (3, 2), (10, 3), (17, 5), (18, 6), (37, 4)] {
-            let a = spd(n, seed);
-            let mut l = a.clone();
-            assert!(cholesky(&mut l, n));
-            let fa = Mat::from_fn(n, n, |r, c| a[r * n + c]);
-            let fl = fa.llt(faer::Side::Lower).unwrap();
-            let fl = fl.L();
-            for r in 0..n {
-                for c in 0..=r {
-                    assert!((l[r * n + c] - fl[(r, c)]).abs() <= 1e-12 * (1.0 + fl[(r, c)].abs()));
-                }
-            }
-            // Only the lower triangle is read.
-            let mut spoilt = a.clone();
-            for r in 0..n {
-                for c in r + 1..n {
-                    spoilt[r * n + c] = f64::NAN;
-                }
-            }
-            assert!(cholesky(&mut spoilt, n), "n = {n}: the upper triangle was read");
-            for r in 0..n {
-                assert_eq!(spoilt[r * n..r * n + r + 1], l[r * n..r * n + r + 1], "n = {n}");
-            }
-            // A forward substitution from a later row, for a right-hand side zero before it,
-            // is the whole one.
-            let start = n / 2;
-            let rhs: Vec<f64> =
-                (0..n).map(|i| if i < start { 0.0 } else { (i as f64).cos() }).collect();
-            let (mut whole, mut from) = (rhs.clone(), rhs.clone());
-            forward_solve_from(&l, n, &mut whole, 0);
-            forward_solve_from(&l, n, &mut from, start);
-            for i in start..n {
-                assert!((whole[i] - from[i]).abs() <= 1e-14 * (1.0 + whole[i].abs()));
-            }
-            let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
-            let mut b: Vec<f64> =
-                (0..n).map(|r| (0..n).map(|c| a[r * n + c] * x_true[c]).sum()).collect();
-            cholesky_solve(&l, n, &mut b);
-            let error = b.iter().zip(&x_true).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
-            assert!(error <= 1e-9, "n = {n}: solve error {error}");
-            let mut inv = vec![0.0; n * n];
-            let mut scratch = vec![0.0; n * n];
-            cholesky_inverse(&l, n, &mut inv, &mut scratch);
-            let mut product = vec![0.0; n * n];
-            multiply(&a, &inv, n, &mut product);
-            for r in 0..n {
-                for c in 0..n {
-                    let expected = if r == c { 1.0 } else { 0.0 };
-                    assert!((product[r * n + c] - expected).abs() <= 1e-8);
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn the_fast_product_is_the_plain_product_and_both_inverses_agree() {
-        for n in [1, 4, 10, 11, 17, 18, 23] {
-            let (a, b) = (spd(n, 7), spd(n, 8));
-            // Not symmetric: a row-scaled copy.
-            let a: Vec<f64> =
-                a.iter().enumerate().map(|(e, v)| v * (1.0 + (e / n) as f64)).collect();
-            let (mut plain, mut fast) = (vec![0.0; n * n], vec![0.0; n * n]);
-            multiply(&a, &b, n, &mut plain);
-            multiply_fast(&a, &b, n, &mut fast);
-            for (p, f) in plain.iter().zip(&fast) {
-                assert!((p - f).abs() <= 1e-12 * (1.0 + p.abs()), "n = {n}: {p} vs {f}");
-            }
-            // The fixed-size and the dynamic lower inverse (n ≤ 17 has both).
-            let mut l = b.clone();
-            assert!(cholesky(&mut l, n));
-            let mut dynamic = vec![0.0; n * n];
-            lower_inverse_dynamic(&l, n, &mut dynamic);
-            let mut product = vec![0.0; n * n];
-            for r in 0..n {
-                for c in 0..n {
-                    product[r * n + c] = (0..=r).map(|p| l[r * n + p] * dynamic[p * n + c]).sum();
-                }
-            }
-            for r in 0..n {
-                for c in 0..n {
-                    let expected = if r == c { 1.0 } else { 0.0 };
-                    assert!((product[r * n + c] - expected).abs() <= 1e-10, "n = {n}: L T ≠ I");
-                }
-            }
-            if n <= 17 {
-                let mut fixed = vec![0.0; n * n];
-                fixed_size!(n, lower_inverse_fixed(&l, &mut fixed), unreachable!());
-                for (x, y) in fixed.iter().zip(&dynamic) {
-                    assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()));
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn cholesky_refuses_indefinite_and_nan() {
-        let mut a = vec![1.0, 2.0, 2.0, 1.0];
-        assert!(!cholesky(&mut a, 2));
-        let mut a = vec![1.0, 0.0, 0.0, f64::NAN];
-        assert!(!cholesky(&mut a, 2));
-        let mut a = vec![1.0, 0.0, 0.0, 0.0];
-        assert!(!cholesky(&mut a, 2), "singular is not positive definite");
-        // Above the fixed sizes: one negative direction in a 30 × 30 identity, at its last row.
-        let n = 30;
-        let mut a: Vec<f64> =
-            (0..n * n).map(|e| if e % (n + 1) == 0 { 1.0 } else { 0.0 }).collect();
-        a[(n - 1) * n + n - 2] = 1.5;
-        a[(n - 2) * n + n - 1] = 1.5;
-        assert!(!cholesky(&mut a, n));
-    }
-
-    #[test]
-    fn inner_is_the_trace_of_the_product() {
-        let a = [2.0, 1.0, 1.0, 3.0];
-        assert_eq!(inner(&a, &[1.0, 0.0, 0.0, 1.0]), 5.0);
-        assert_eq!(inner(&a, &a), 4.0 + 1.0 + 1.0 + 9.0);
-    }
-}
+mod tests;

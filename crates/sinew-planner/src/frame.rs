@@ -304,8 +304,10 @@ impl Frame {
         }
     }
 
-    /// `R`: an orthonormal basis of `null(J_r)` (n × (n − 3), row-major), by Gram–Schmidt
-    /// twice on the rotation rows and then the unit vectors; `None` when `J_r` has rank < 3.
+    /// `R`: an orthonormal basis of `null(J_r)` (n × (n − 3), row-major), the last n − 3
+    /// columns of `Q = H₀ H₁ H₂`, the Householder reflections that triangularise `J_rᵀ`
+    /// (n × 3); `None` when `J_r` has rank < 3 (a column's part on and below the diagonal,
+    /// once reflected, is at most 1e-9 of its norm).
     #[cfg(test)]
     pub(crate) fn rotation_null_basis(&self) -> Option<Vec<f64>> {
         let (mut basis, mut out) = (Vec::new(), Vec::new());
@@ -313,109 +315,117 @@ impl Frame {
     }
 
     /// [`Self::rotation_null_basis`] into `out`, `basis` scratch (both reused): whether there
-    /// is one.
+    /// is one. `O(n²)`: three reflections applied to the n − 3 unit columns.
     pub(crate) fn rotation_null_basis_into(
         &self,
         basis: &mut Vec<f64>,
         out: &mut Vec<f64>,
     ) -> bool {
+        use crate::dense::{axpy, dot};
         let n = self.n;
         out.clear();
         if n < 6 {
             return false;
         }
-        // The orthonormal vectors so far, one after another (n each); the candidate after them.
+        let p = n - 3;
+        // The columns of J_rᵀ (n each), then the reflections' vectors v_j (zero above row j),
+        // then a row of p.
         basis.clear();
-        let orthogonalise = |basis: &mut [f64], count: usize| {
-            let (done, v) = basis.split_at_mut(count * n);
-            for _ in 0..2 {
-                for b in done.chunks_exact(n) {
-                    let d: f64 = v.iter().zip(b).map(|(a, c)| a * c).sum();
-                    for (x, y) in v.iter_mut().zip(b) {
-                        *x -= d * y;
-                    }
-                }
-            }
-        };
-        let normalise = |basis: &mut [f64], count: usize, norm: f64| {
-            for x in &mut basis[count * n..] {
-                *x /= norm;
-            }
-        };
-        let norm_of = |basis: &[f64], count: usize| {
-            basis[count * n..].iter().map(|x| x * x).sum::<f64>().sqrt()
-        };
-        for r in 3..6 {
-            let count = r - 3;
-            basis.extend_from_slice(&self.j_x[r * n..r * n + n]);
-            let scale = norm_of(basis, count);
-            orthogonalise(basis, count);
-            let norm = norm_of(basis, count);
-            if !(norm > 1e-9 * scale && norm.is_finite()) {
+        basis.extend_from_slice(&self.j_x[3 * n..6 * n]);
+        basis.resize(6 * n + p, 0.0);
+        let (columns, rest) = basis.split_at_mut(3 * n);
+        let (vectors, w) = rest.split_at_mut(3 * n);
+        let mut betas = [0.0; 3];
+        for j in 0..3 {
+            let (done, later) = columns.split_at_mut((j + 1) * n);
+            let column = &done[j * n..];
+            let (scale, alpha) =
+                (dot(column, column).sqrt(), dot(&column[j..], &column[j..]).sqrt());
+            if !(alpha > 1e-9 * scale && alpha.is_finite()) {
                 return false;
             }
-            normalise(basis, count, norm);
-        }
-        let mut count = 3;
-        for e in 0..n {
-            if count == n {
-                break;
-            }
-            basis.extend(std::iter::repeat_n(0.0, n));
-            basis[count * n + e] = 1.0;
-            orthogonalise(basis, count);
-            let norm = norm_of(basis, count);
-            if norm > 0.3 {
-                normalise(basis, count, norm);
-                count += 1;
-            } else {
-                basis.truncate(count * n);
+            let v = &mut vectors[j * n..j * n + n];
+            v[j..].copy_from_slice(&column[j..]);
+            v[j] += if column[j] >= 0.0 { alpha } else { -alpha };
+            betas[j] = 2.0 / dot(&v[j..], &v[j..]);
+            for c in later.chunks_exact_mut(n) {
+                let d = betas[j] * dot(&v[j..], &c[j..]);
+                axpy(-d, &v[j..], &mut c[j..]);
             }
         }
-        // Row-major n × (n − 3): R[r, c] = basis[3 + c][r].
-        if count != n {
-            return false;
+        // Q E, E the unit columns 3..n: H₂, then H₁, then H₀, each `X −= β v (vᵀ X)`.
+        out.resize(n * p, 0.0);
+        for c in 0..p {
+            out[(c + 3) * p + c] = 1.0;
         }
-        for r in 0..n {
-            for c in 0..n - 3 {
-                out.push(basis[(3 + c) * n + r]);
+        for j in (0..3).rev() {
+            let v = &vectors[j * n..j * n + n];
+            w.fill(0.0);
+            for r in j..n {
+                axpy(v[r], &out[r * p..r * p + p], w);
+            }
+            for r in j..n {
+                axpy(-betas[j] * v[r], w, &mut out[r * p..r * p + p]);
             }
         }
         true
     }
 }
 
-/// `Rᵀ M R` (M n × n symmetric, R n × p, both row-major) into `out` (p × p), over the rows
-/// of `M` that are not zero only (a decoupled `A_i` has two): `Σ_{i ∈ S} R_iᵀ (M R)_i`. `rows`
-/// and `mr` are scratch, reused.
+/// `Rᵀ M R` (M n × n symmetric, R n × p, both row-major) into `out` (p × p), symmetric, by
+/// two of faer's products (`t`, n × p, scratch).
 pub(crate) fn congruence(
     m: &[f64],
     r: &[f64],
     (n, p): (usize, usize),
-    (rows, mr): (&mut Vec<usize>, &mut Vec<f64>),
+    t: &mut Vec<f64>,
     out: &mut [f64],
 ) {
-    rows.clear();
-    rows.extend((0..n).filter(|&i| m[i * n..i * n + n].iter().any(|v| *v != 0.0)));
-    mr.clear();
-    mr.resize(n * p, 0.0);
-    for &i in rows.iter() {
-        for k in 0..n {
-            let v = m[i * n + k];
-            if v == 0.0 {
-                continue;
+    use faer::{Accum, MatMut, MatRef, Par};
+    t.clear();
+    t.resize(n * p, 0.0);
+    let (m, r) = (
+        MatRef::from_row_major_slice(&m[..n * n], n, n),
+        MatRef::from_row_major_slice(&r[..n * p], n, p),
+    );
+    faer::linalg::matmul::matmul(
+        MatMut::from_row_major_slice_mut(t, n, p),
+        Accum::Replace,
+        m,
+        r,
+        1.0,
+        Par::Seq,
+    );
+    let t = MatRef::from_row_major_slice(t, n, p);
+    let o = MatMut::from_row_major_slice_mut(&mut out[..p * p], p, p);
+    faer::linalg::matmul::matmul(o, Accum::Replace, r.transpose(), t, 1.0, Par::Seq);
+    crate::dense::symmetrise(out, p);
+}
+
+/// `out += Rᵀ (scale · M) R` for an `M` that is zero outside `span × span` (`m` its square
+/// there, row-major; a decoupled `A_i` is one 2 × 2 joint block), R n × p row-major, `out`
+/// p × p and symmetric afterwards: `Σ_{i ∈ span} R_iᵀ t_i`, `t_i = Σ_{j ∈ span} scale m_ij R_j`
+/// (`t` p scratch), `O(|span| p²)` instead of a dense congruence's `O(n p²)`.
+pub(crate) fn span_congruence(
+    (m, span, scale): (&[f64], Range<usize>, f64),
+    r: &[f64],
+    p: usize,
+    t: &mut Vec<f64>,
+    out: &mut [f64],
+) {
+    let w = span.len();
+    for (i, row) in span.clone().zip(m.chunks_exact(w.max(1))) {
+        t.clear();
+        t.resize(p, 0.0);
+        for (j, v) in span.clone().zip(row) {
+            if *v != 0.0 {
+                crate::dense::axpy(scale * v, &r[j * p..j * p + p], t);
             }
-            crate::dense::axpy(v, &r[k * p..k * p + p], &mut mr[i * p..i * p + p]);
         }
-    }
-    out.fill(0.0);
-    for &i in rows.iter() {
-        for a in 0..p {
-            let ra = r[i * p + a];
-            if ra == 0.0 {
-                continue;
+        for (a, ra) in r[i * p..i * p + p].iter().enumerate() {
+            if *ra != 0.0 {
+                crate::dense::axpy(*ra, t, &mut out[a * p..a * p + p]);
             }
-            crate::dense::axpy(ra, &mr[i * p..i * p + p], &mut out[a * p..a * p + p]);
         }
     }
     crate::dense::symmetrise(out, p);

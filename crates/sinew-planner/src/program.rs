@@ -188,7 +188,12 @@ pub(crate) enum End {
 }
 
 /// The certified upper bound at `x` with `(y, Z)` (module docs), given the slacks `s` and the
-/// blocks' values `S_j` (row-major).
+/// blocks' values `S_j` (row-major). `known(a, j)` is `⟨Z_j, F_ja⟩` where the caller has it
+/// at less cost than the n × n inner product (a factored block's `tr(B_a (R Z Rᵀ)[s_a, s_a])`,
+/// `block_work.rs`), else `None`. Inlined into the run, so that its inner products get the
+/// run's vector instructions (`sdp.rs`).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn upper_bound<'m>(
     sdp: &Sdp,
     x: &[f64],
@@ -197,10 +202,13 @@ pub(crate) fn upper_bound<'m>(
     s: &[f64],
     slack_matrices: impl Iterator<Item = &'m [f64]>,
     duals: &Duals,
+    known: impl Fn(usize, usize) -> Option<f64>,
 ) -> f64 {
     let k = sdp.vars();
     let dual_term = |a: usize, j: usize, z: &[f64]| -> f64 {
-        sdp.blocks[j].coefficients[a].as_ref().map_or(0.0, |f| inner(f, z))
+        sdp.blocks[j].coefficients[a]
+            .as_ref()
+            .map_or(0.0, |f| known(a, j).unwrap_or_else(|| inner(f, z)))
     };
     // The epigraph block's scale κ (every other block's is 1).
     let mut epigraph = None;
@@ -267,7 +275,7 @@ pub(crate) fn bound_at(
     let inside = s.iter().all(|v| *v >= 0.0)
         && sdp.blocks.iter().zip(&matrices).all(|(b, m)| cholesky(&mut m.clone(), b.n));
     let refs = matrices.iter().map(Vec::as_slice);
-    inside.then(|| upper_bound(sdp, x, value, gradient, &s, refs, duals))
+    inside.then(|| upper_bound(sdp, x, value, gradient, &s, refs, duals, |_, _| None))
 }
 
 /// Multipliers on the central path at `x`, `y = μ/s`, `Z_j = μ S_j⁻¹`, with `μ` the

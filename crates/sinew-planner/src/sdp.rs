@@ -14,12 +14,16 @@
 //!
 //! solved by Cholesky. The predictor takes `σ = 0`; `σ = (μ_aff/μ)³` and the second-order
 //! terms `Δs∘Δy` and `sym(ΔZ ΔS S⁻¹)` of the predictor enter the corrector (Mehrotra). Step
-//! lengths are found by Cholesky trials, 95 % of the way to the boundary. The primal iterate
+//! lengths are found by Cholesky trials, 95 % of the way to the boundary (the corrector's
+//! bracketed to within 6 %, `block_work::step_length`). The primal iterate
 //! stays strictly feasible (every phase starts from such a point), so `s` and `S` are functions
 //! of `x`.
 
-use crate::block_work::{BlockWork, add_block_schur, matrix_step, step_length, sym_product, zs};
-use crate::dense::{axpy, cholesky, cholesky_inverse, cholesky_solve, dot, inner};
+use crate::block_work::{
+    BlockWork, add_block_schur, dual_congruence, factored_dual_term, matrix_step, step_length,
+    sym_product, zs,
+};
+use crate::dense::{axpy, cholesky, cholesky_inverse, cholesky_solve, cholesky_whole, dot, inner};
 pub(crate) use crate::program::{Block, Duals, End, Run, Sdp, Settings, Smooth};
 use crate::program::{centred_duals, resize_pooled, upper_bound};
 
@@ -152,7 +156,7 @@ fn solve_body<'s>(
             for (b, w) in sdp.blocks.iter().zip(works.iter_mut()) {
                 b.at(x, &mut w.s);
                 w.l.copy_from_slice(&w.s);
-                interior &= cholesky(&mut w.l, b.n);
+                interior &= cholesky_whole(&mut w.l, b.n, true);
                 if interior {
                     cholesky_inverse(&w.l, b.n, &mut w.s_inv, &mut w.t1);
                 }
@@ -194,9 +198,14 @@ fn solve_body<'s>(
         let mu = (dot(&duals.y, s)
             + works.iter().zip(&duals.z).map(|(w, z)| inner(z, &w.s)).sum::<f64>())
             / nu.max(1.0);
+        // A factored block's `R Z Rᵀ`: its dual terms here, its Schur terms below.
+        for ((b, w), z) in sdp.blocks.iter().zip(works.iter_mut()).zip(&duals.z) {
+            dual_congruence(b, z, w);
+        }
         let upper = {
             let matrices = works.iter().map(|w| w.s.as_slice());
-            upper_bound(sdp, x, value, &v.gradient, s, matrices, duals)
+            let known = |a: usize, j: usize| factored_dual_term(&sdp.blocks[j], &works[j], a);
+            upper_bound(sdp, x, value, &v.gradient, s, matrices, duals, known)
         };
         best = Some((value, upper));
         if let Some(target) = settings.target {
@@ -257,9 +266,9 @@ fn solve_body<'s>(
                 *d = -zz - o;
             }
         }
-        let alpha_p = step_length(s, &v.ds_aff_row, works, |w| (&w.s, &w.ds_aff));
+        let alpha_p = step_length(s, &v.ds_aff_row, works, |w| (&w.s, &w.ds_aff), false);
         zs(works, duals);
-        let alpha_d = step_length(&duals.y, &v.dy_aff, works, |w| (&w.t2, &w.dz_aff));
+        let alpha_d = step_length(&duals.y, &v.dy_aff, works, |w| (&w.t2, &w.dz_aff), false);
         let mut mu_aff = 0.0;
         for r in 0..p {
             mu_aff += (s[r] + alpha_p * v.ds_aff_row[r]) * (duals.y[r] + alpha_d * v.dy_aff[r]);
@@ -302,9 +311,9 @@ fn solve_body<'s>(
                 w.dz[e] = w.correction[e] - z[e] - w.product[e];
             }
         }
-        let alpha_p = step_length(s, &v.ds_row, works, |w| (&w.s, &w.ds));
+        let alpha_p = step_length(s, &v.ds_row, works, |w| (&w.s, &w.ds), true);
         zs(works, duals);
-        let alpha_d = step_length(&duals.y, &v.dy, works, |w| (&w.t2, &w.dz));
+        let alpha_d = step_length(&duals.y, &v.dy, works, |w| (&w.t2, &w.dz), true);
         v.previous.copy_from_slice(x);
         last_step = Some(alpha_p);
         axpy(alpha_p, &v.dx, x);
