@@ -111,12 +111,7 @@ fn cholesky_fixed<const N: usize>(a: &mut [f64]) -> bool {
 /// mirrored into the upper one; the factor, written into the column-major lower triangle
 /// (the row-major upper one), is then mirrored back into the row-major lower triangle.
 fn cholesky_dynamic(a: &mut [f64], n: usize) -> bool {
-    let a = &mut a[..n * n];
-    for i in 0..n {
-        for j in 0..i {
-            a[j * n + i] = a[i * n + j];
-        }
-    }
+    mirror_lower(a, n);
     whole_dynamic(a, n, true)
 }
 
@@ -245,10 +240,14 @@ fn inverse_dynamic(l: &[f64], n: usize, out: &mut [f64], t: &mut [f64]) {
     let o = MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n);
     let (lower, upper) = (BlockStructure::TriangularLower, BlockStructure::TriangularUpper);
     matmul(o, lower, Accum::Replace, tr.transpose(), upper, tr, lower, 1.0, Par::Seq);
-    let out = &mut out[..n * n];
-    for r in 0..n {
+    mirror_lower(out, n);
+}
+
+/// The upper triangle of the row-major square `out` (side `side`) set to its lower one's.
+pub(crate) fn mirror_lower(out: &mut [f64], side: usize) {
+    for r in 0..side {
         for c in 0..r {
-            out[c * n + r] = out[r * n + c];
+            out[c * side + r] = out[r * side + c];
         }
     }
 }

@@ -15,6 +15,7 @@ use std::ops::Range;
 use sinew_statics::EquilibriumSet;
 
 use crate::bundle::Linear;
+use crate::dense::mirror_lower;
 use crate::pencil::Pencil;
 
 /// The pencil, the rows and the box in the scaled coordinates `x`.
@@ -94,15 +95,6 @@ fn add_symmetric(
             let upper = a.col_as_slice(r)[c];
             let o = &mut row[k * side + (c - origin)];
             *o = (*o + half * lower) + half * upper;
-        }
-    }
-}
-
-/// The upper triangle of the row-major square `out` (side `side`) set to its lower one's.
-fn mirror_lower(out: &mut [f64], side: usize) {
-    for r in 0..side {
-        for c in 0..r {
-            out[c * side + r] = out[r * side + c];
         }
     }
 }
