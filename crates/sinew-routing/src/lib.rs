@@ -59,8 +59,8 @@ mod vec3;
 
 pub use error::{JointProblem, Result, RoutingError};
 pub use friction::{
-    DofRow, FrictionData, FrictionModel, SegmentRows, Slip, WRAP_KINK, compute_capstan_weights,
-    compute_friction_geometry,
+    CableRows, DofRow, FrictionData, FrictionModel, SegmentRows, Slip, WRAP_KINK, WeightGradient,
+    compute_capstan_weights, compute_friction_geometry,
 };
 pub use geometry::{
     HessianBatch, Order, RoutingData, SegmentHessians, compute_cable_geometry,

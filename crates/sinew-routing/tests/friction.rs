@@ -352,3 +352,106 @@ fn a_straight_cdhrm5_has_no_wrap_and_pull_weights_fall_distally_elsewhere() {
         }
     }
 }
+
+// The two ways the friction geometry gets each segment's `J_s`. With the routing's Jacobian at
+// hand (`Order::Jacobian` and above), a cable whose segments cross distinct DOFs reads `J_s`
+// from `J_c`; otherwise (`Order::Lengths`, or two segments of one cable across one DOF: the
+// zigzag case) the routing's formula runs again per segment. Both must give the same rows bit
+// for bit, and everything computed from them too: a copy from the wrong row or column, a
+// segment turned the wrong way, or a stale row fails here.
+
+fn geometry(
+    robot: &Robot,
+    routing: &Routing,
+    model: &FrictionModel,
+    q: &[f64],
+    order: Order,
+) -> FrictionData {
+    let mut rdata = RobotData::new(robot);
+    let mut routing_data = RoutingData::new(routing);
+    compute_cable_geometry(routing, robot, &mut rdata, &mut routing_data, q, order).unwrap();
+    let mut data = FrictionData::new(model);
+    compute_friction_geometry(model, routing, &routing_data, &mut data).unwrap();
+    data
+}
+
+fn bits(values: &[f64]) -> Vec<u64> {
+    values.iter().map(|v| v.to_bits()).collect()
+}
+
+#[test]
+fn j_s_read_from_j_c_is_the_routing_formula_bit_for_bit() {
+    for (case, robot, routing, _) in cases() {
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+        for q in random_qs(&robot, 3, 7) {
+            let formula = geometry(&robot, &routing, &model, &q, Order::Lengths);
+            let copied = geometry(&robot, &routing, &model, &q, Order::Hessians);
+            for c in 0..model.cable_count() {
+                let h = model.segment_count(c).unwrap();
+                for s in 0..h {
+                    let (a, b) = (
+                        formula.segment_jacobian(&model, c, s).unwrap(),
+                        copied.segment_jacobian(&model, c, s).unwrap(),
+                    );
+                    assert_eq!(a.dofs, b.dofs, "{case}: J_s dofs, cable {c} segment {s}");
+                    assert_eq!(
+                        bits(a.values),
+                        bits(b.values),
+                        "{case}: J_s, cable {c} segment {s}"
+                    );
+                }
+                for k in 0..h - 1 {
+                    let (a, b) = (
+                        formula.wrap_gradient(&model, c, k).unwrap(),
+                        copied.wrap_gradient(&model, c, k).unwrap(),
+                    );
+                    assert_eq!(bits(a.values), bits(b.values), "{case}: ∂θ, cable {c} hole {k}");
+                }
+                let pairs = [
+                    (formula.lengths(&model, c).unwrap(), copied.lengths(&model, c).unwrap()),
+                    (
+                        formula.wrap_angles(&model, c).unwrap(),
+                        copied.wrap_angles(&model, c).unwrap(),
+                    ),
+                ];
+                for (a, b) in pairs {
+                    assert_eq!(bits(a), bits(b), "{case}: lengths or wrap angles, cable {c}");
+                }
+                let (a, b) =
+                    (formula.directions(&model, c).unwrap(), copied.directions(&model, c).unwrap());
+                assert_eq!(a, b, "{case}: directions, cable {c}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_cable_view_reads_the_rows_of_the_accessors() {
+    for (case, robot, routing, _) in cases().into_iter().take(4) {
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+        let q = random_qs(&robot, 1, 11).remove(0);
+        let mut data = geometry(&robot, &routing, &model, &q, Order::Hessians);
+        let view = data.cable(&model, 0).unwrap();
+        assert!(view.weights.is_none(), "{case}: weights before they are computed");
+        compute_capstan_weights(&model, &mut data, Slip::Release).unwrap();
+        for c in 0..model.cable_count() {
+            let view = data.cable(&model, c).unwrap();
+            let h = model.segment_count(c).unwrap();
+            assert_eq!(view.len(), h, "{case}");
+            assert_eq!(view.lengths, data.lengths(&model, c).unwrap(), "{case}");
+            assert_eq!(view.weights.unwrap(), data.weights(&model, c).unwrap(), "{case}");
+            assert_eq!(&view.wrap[..h - 1], data.wrap_angles(&model, c).unwrap(), "{case}");
+            for s in 0..h {
+                assert_eq!(view.jacobian(s), data.segment_jacobian(&model, c, s).unwrap());
+                assert_eq!(view.routing_segment(s), model.routing_segment(c, s), "{case}");
+                if s + 1 < h {
+                    assert_eq!(view.wrap_gradient(s), data.wrap_gradient(&model, c, s).unwrap());
+                }
+            }
+            // Past the end: empty rows, no segment.
+            assert!(view.jacobian(h).values.is_empty() && view.wrap_gradient(h).values.is_empty());
+            assert_eq!(view.routing_segment(h), None);
+        }
+        assert!(data.cable(&model, model.cable_count()).is_err(), "{case}: no such cable");
+    }
+}

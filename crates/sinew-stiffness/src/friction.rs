@@ -17,7 +17,7 @@
 
 use faer::MatRef;
 use sinew_routing::{
-    FrictionData, FrictionModel, Routing, RoutingError, SegmentHessians, SegmentRows, Slip,
+    CableRows, FrictionData, FrictionModel, Routing, RoutingError, SegmentHessians, Slip,
 };
 
 use crate::colmajor::{ColMajor, mirror_upper};
@@ -74,8 +74,9 @@ pub struct FrictionStiffnessData {
     pub(crate) series_elastic: ColMajor,
     /// Scratch (slip), dof × m: column `c` is `T_0 g_c / C̃_c`, `g_c = Σ_s c_s ∂w_s/∂Q`.
     pub(crate) moving_series_t: ColMajor,
-    /// Scratch (slip), dof × dof: `T_0 Σ_s ∇w_sᵀ J_s`, the transpose of its term of `K`.
-    pub(crate) moving_transposed: ColMajor,
+    /// Scratch (slip), one per DOF: the running sum `G_k = σμ T_0 Σ_{s>k} w_s J_s` of one
+    /// cable (zero between cables).
+    pub(crate) suffix: Vec<f64>,
 }
 
 impl FrictionStiffnessData {
@@ -93,7 +94,7 @@ impl FrictionStiffnessData {
             skew_norm: 0.0,
             series_elastic: ColMajor::zeros(m, n),
             moving_series_t: ColMajor::zeros(n, m),
-            moving_transposed: ColMajor::zeros(n, n),
+            suffix: vec![0.0; n],
         }
     }
 
@@ -212,28 +213,37 @@ impl FrictionStiffnessData {
     }
 }
 
-/// `out[dofs, dofs] += scale · H_s` for the friction segment `segment` (the routing's segment
+/// `out[dofs, dofs] += scale · H_s` for friction segment `s` of `cable` (the routing's segment
 /// Hessian from `hessians`, over `J_s`'s DOFs, entry by entry column by column: the order of
 /// `RoutingData::add_weighted_hessians`); nothing for the free length.
+#[inline]
 pub(crate) fn add_segment_hessian(
     (routing, hessians): (&Routing, &SegmentHessians<'_>),
-    segment: &SegmentRows<'_>,
+    (cable, s): (&CableRows<'_>, usize),
     scale: f64,
     out: &mut ColMajor,
 ) -> Result<(), StiffnessError> {
-    let Some(r) = segment.routing_segment else {
+    let Some(r) = cable.routing_segment(s) else {
         return Ok(());
     };
-    let Some(h) = hessians.get(r) else {
+    let Some(h) = hessians.entries(r) else {
         let expected = routing.segments().len();
         return Err(
             RoutingError::DimensionMismatch { what: "segment index", expected, got: r }.into()
         );
     };
-    let dofs = segment.jacobian.dofs.clone();
-    for (k, col) in dofs.clone().enumerate() {
-        for (i, o) in out.col_mut(col)[dofs.clone()].iter_mut().enumerate() {
-            *o += scale * h[(i, k)];
+    let dofs = cable.jacobian(s).dofs;
+    let n = dofs.len();
+    if n == 0 {
+        return Ok(());
+    }
+    // Blocks are 2 × 2 to 4 × 4: plain index loops (an iterator chain here vectorises for
+    // long columns and pays its dispatch on every tiny block).
+    for k in 0..n {
+        let column = &mut out.col_mut(dofs.start + k)[dofs.clone()];
+        let h = &h[k * n..(k + 1) * n];
+        for i in 0..n {
+            column[i] += scale * h[i];
         }
     }
     Ok(())

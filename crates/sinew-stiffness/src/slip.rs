@@ -28,6 +28,19 @@
 //!                         (controllable: ∝ T_0)                       (inherent)
 //! ```
 //!
+//! *Computed from the anchor back, no row `∇w_s` stored.* With `∇w_s = σμ w_s Σ_{k<s} ∇θ_k`
+//! (`σμ` the regime's rate), both sums over the moving weights are sums over the holes, each
+//! with a running sum of the segments beyond it:
+//!
+//! ```text
+//! T_0 Σ_s J_sᵀ ∇w_s = Σ_k G_k ∇θ_k,   G_k = σμ T_0 Σ_{s>k} w_s J_sᵀ     (a dof column)
+//! g = Σ_s c_s ∇w_s   = σμ Σ_k S_k ∇θ_k,   S_k = Σ_{s>k} c_s w_s
+//! ```
+//!
+//! One pass from the anchor to the first hole adds each `w_s J_s` to `G` and each `c_s w_s` to
+//! `S`; each hole then adds `∂θ_k/∂q_j G_k` to column `j` of `K` (contiguous) for the few DOFs
+//! `j` its wrap angle depends on. Cost `O(Σ_k |wrap dofs_k| · |reach of G_k|)`.
+//!
 //! It is not symmetric (`J̃ ≠ J_c`, and the weights move with `Q`): the workspace reports its
 //! symmetric part and the norm of its skew part. It is the stiffness for motions that keep
 //! every hole sliding the same way, with the slip direction held (the weights stay those of
@@ -85,9 +98,11 @@ pub fn slip_stiffness(
     // order); the μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal, then mirrored.
     let hessians = (routing, &geometry.segment_hessians(routing)?);
     for (c, &t_0) in actuator.iter().enumerate() {
-        for segment in friction.segments(model, c)?.skip(1) {
-            let w = segment.weight.unwrap_or(1.0);
-            add_segment_hessian(hessians, &segment, t_0 * w, &mut out.controllable)?;
+        let cable = friction.cable(model, c)?;
+        let weights = cable.weights.unwrap_or(&[]);
+        for s in 1..cable.len() {
+            let w = weights.get(s).copied().unwrap_or(1.0);
+            add_segment_hessian(hessians, (&cable, s), t_0 * w, &mut out.controllable)?;
         }
         if mu[c] == 0.0 {
             let cable = &routing.cables()[c];
@@ -101,10 +116,10 @@ pub fn slip_stiffness(
         }
     }
     out.mirror_inherent();
-    // Pass 2, the cables with friction: the pieces in series. Per cable, the rows
-    // `J_c / C̃` and `T_0 g / C̃` of two m × dof matrices, and `T_0 Σ_s J_sᵀ ∇w_s` transposed
-    // (each `∇w_s` a contiguous row: one axpy per DOF of `J_s`); then `J̃ᵀ` times each matrix
-    // (faer's product: the cables' rank-one terms `J̃_cᵀ (…)` summed at once).
+    // Pass 2, the cables with friction: the pieces in series. Per cable, the rows `J_c / C̃`
+    // and `T_0 g / C̃` of two m × dof matrices, and `T_0 Σ_s J_sᵀ ∇w_s` straight into `K`
+    // (module docs: one pass from the anchor back, with the running sums `S_k` and `G_k`);
+    // then `J̃ᵀ` times each matrix (faer's product: the cables' rank-one terms summed at once).
     if mu.iter().all(|&mu| mu == 0.0) {
         out.finish(FrictionRegime::Slip(slip));
         return Ok(());
@@ -113,53 +128,69 @@ pub fn slip_stiffness(
     let j_tilde = friction.effective_jacobian()?;
     out.series_elastic.as_mut_slice().fill(0.0);
     out.moving_series_t.as_mut_slice().fill(0.0);
-    out.moving_transposed.as_mut_slice().fill(0.0);
+    let n = out.dof;
+    let FrictionStiffnessData { controllable, series_elastic, moving_series_t, suffix, .. } = out;
+    suffix.fill(0.0);
     for (c, &t_0) in actuator.iter().enumerate() {
         if mu[c] == 0.0 {
             continue;
         }
-        // g = Σ_s c_s ∇w_s accumulates in column c of the transposed scratch (contiguous).
-        let (mut series, mut reach) = (0.0, 0..0);
-        for segment in friction.segments(model, c)? {
-            let (Some(w), Some(grad_w)) = (segment.weight, segment.weight_gradient) else {
-                let computed = friction.slip();
-                return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed });
-            };
-            let c_s = segment.length / ea;
-            series += c_s * w;
-            let g = &mut out.moving_series_t.col_mut(c)[grad_w.dofs.clone()];
-            for (o, v) in g.iter_mut().zip(grad_w.values) {
-                *o += c_s * v;
+        let cable = friction.cable(model, c)?;
+        let Some(weights) = cable.weights else {
+            return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed: None });
+        };
+        let rate = slip.sign() * mu[c];
+        // C̃ = Σ_s c_s w_s, c_s = ℓ_s / (E A), in segment order.
+        let series: f64 = cable.lengths.iter().zip(weights).map(|(l, w)| l / ea * w).sum();
+        // From the anchor back: before hole k, S_k = Σ_{s>k} c_s w_s and
+        // G_k = σμ T_0 Σ_{s>k} w_s J_s (dense over `lo..hi`); then
+        // g += σμ S_k ∇θ_k and column j of K += ∂θ_k/∂q_j G_k.
+        let g = moving_series_t.col_mut(c);
+        let (mut s_k, mut lo, mut hi, mut g_lo, mut g_hi) = (0.0, n, 0, n, 0);
+        for k in (0..cable.len().saturating_sub(1)).rev() {
+            let s = k + 1;
+            s_k += cable.lengths[s] / ea * weights[s];
+            let j_s = cable.jacobian(s);
+            if !j_s.dofs.is_empty() {
+                let a = rate * t_0 * weights[s];
+                for (o, v) in suffix[j_s.dofs.clone()].iter_mut().zip(j_s.values) {
+                    *o += a * v;
+                }
+                (lo, hi) = (lo.min(j_s.dofs.start), hi.max(j_s.dofs.end));
             }
-            // T_0 J_sᵀ ∇w_s, transposed: column i of the scratch += T_0 J_s[i] ∇w_s.
-            let j_s = segment.jacobian;
-            for (v, i) in j_s.values.iter().zip(j_s.dofs.clone()) {
-                let tv = t_0 * v;
-                let column = &mut out.moving_transposed.col_mut(i)[grad_w.dofs.clone()];
-                for (o, g) in column.iter_mut().zip(grad_w.values) {
-                    *o += tv * g;
+            let theta = cable.wrap_gradient(k);
+            if theta.dofs.is_empty() {
+                continue;
+            }
+            (g_lo, g_hi) = (g_lo.min(theta.dofs.start), g_hi.max(theta.dofs.end));
+            let rate_s = rate * s_k;
+            for (j, &d) in theta.dofs.clone().zip(theta.values) {
+                g[j] += rate_s * d;
+                if lo < hi {
+                    let column = &mut controllable.col_mut(j)[lo..hi];
+                    for (o, gk) in column.iter_mut().zip(&suffix[lo..hi]) {
+                        *o += d * gk;
+                    }
                 }
             }
-            reach = grad_w.dofs;
+        }
+        if lo < hi {
+            suffix[lo..hi].fill(0.0);
+        }
+        if g_lo < g_hi {
+            for v in &mut g[g_lo..g_hi] {
+                *v *= t_0 / series;
+            }
         }
         // The rows of J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
         for j in routing.cables()[c].dofs.clone() {
-            *out.series_elastic.at_mut(c, j) = j_c[(c, j)] / series;
-        }
-        for v in &mut out.moving_series_t.col_mut(c)[reach] {
-            *v *= t_0 / series;
+            *series_elastic.at_mut(c, j) = j_c[(c, j)] / series;
         }
     }
     let (elastic, moving) = (out.series_elastic.as_ref(), out.moving_series_t.as_ref().transpose());
     let (inherent, controllable) = (out.inherent.as_mut(), out.controllable.as_mut());
     matmul(inherent, Accum::Add, j_tilde.transpose(), elastic, 1.0, Par::Seq);
     matmul(controllable, Accum::Add, j_tilde.transpose(), moving, -1.0, Par::Seq);
-    let n = out.dof;
-    for j in 0..n {
-        for i in 0..n {
-            *out.controllable.at_mut(i, j) += out.moving_transposed.at(j, i);
-        }
-    }
     out.finish(FrictionRegime::Slip(slip));
     Ok(())
 }

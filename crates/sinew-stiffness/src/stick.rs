@@ -59,15 +59,16 @@ pub fn stick_stiffness(
     let ea = axial_rigidity(routing);
     let hessians = (routing, &geometry.segment_hessians(routing)?);
     for (c, &t_0) in actuator.iter().enumerate() {
-        for segment in friction.segments(model, c)?.skip(1) {
-            let t_s = match history {
-                History::Equal => t_0,
-                History::Pull | History::Release => t_0 * segment.weight.unwrap_or(1.0),
+        let cable = friction.cable(model, c)?;
+        for s in 1..cable.len() {
+            let t_s = match (history, cable.weights) {
+                (History::Pull | History::Release, Some(w)) => t_0 * w[s],
+                _ => t_0,
             };
-            add_segment_hessian(hessians, &segment, t_s, &mut out.controllable)?;
+            add_segment_hessian(hessians, (&cable, s), t_s, &mut out.controllable)?;
             // J_sᵀ k_s J_s on and above the diagonal (mirrored below once every cable is in).
-            let j_s = &segment.jacobian;
-            let k_s = ea / segment.length;
+            let j_s = cable.jacobian(s);
+            let k_s = ea / cable.lengths[s];
             for (jj, j) in j_s.dofs.clone().enumerate() {
                 let kj = k_s * j_s.values[jj];
                 for (ii, i) in j_s.dofs.clone().enumerate().take(jj + 1) {

@@ -4,7 +4,7 @@ use std::ops::Range;
 
 use faer::MatRef;
 
-use super::model::{FrictionModel, Slip, Slot};
+use super::model::{Entry, FrictionModel, Slip, Slot};
 use crate::error::{Result, RoutingError};
 
 /// A row over a range of DOFs: `values[j]` is the entry of DOF `dofs.start + j`; every DOF
@@ -24,6 +24,23 @@ impl DofRow<'_> {
     }
 }
 
+/// `∂w_s/∂Q` of one friction segment ([`FrictionData::weight_gradient`]): a row over a range
+/// of DOFs, every DOF outside it an exact zero.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeightGradient {
+    /// The DOFs the row covers.
+    pub dofs: Range<usize>,
+    /// One value per DOF of `dofs`, 1/rad.
+    pub values: Vec<f64>,
+}
+
+impl WeightGradient {
+    /// The entry of DOF `d` (0 outside [`WeightGradient::dofs`]).
+    pub fn get(&self, d: usize) -> f64 {
+        if self.dofs.contains(&d) { self.values[d - self.dofs.start] } else { 0.0 }
+    }
+}
+
 /// One friction segment of a cable at the computed geometry, as
 /// [`FrictionData::segments`] yields them: what the stiffness of every regime reads per
 /// segment, checked once per cable instead of once per access.
@@ -35,8 +52,6 @@ pub struct SegmentRows<'a> {
     pub weight: Option<f64>,
     /// `J_s` over the segment's DOFs ([`FrictionData::segment_jacobian`]).
     pub jacobian: DofRow<'a>,
-    /// `∂w_s/∂Q` ([`FrictionData::weight_gradient`]; `None` before the weights).
-    pub weight_gradient: Option<DofRow<'a>>,
     /// `∂θ_s/∂Q` of hole `s`, where the segment ends ([`FrictionData::wrap_gradient`]; empty
     /// for the anchor, which has no wrap angle).
     pub wrap_gradient: DofRow<'a>,
@@ -44,6 +59,54 @@ pub struct SegmentRows<'a> {
     /// `H_s` over [`SegmentRows::jacobian`]'s DOFs ([`crate::SegmentHessians::get`]).
     pub routing_segment: Option<usize>,
 }
+
+/// One cable's rows at the computed geometry, as [`FrictionData::cable`] gives them: the
+/// workspace checked against the model once, then each row read on demand (the slip and stick
+/// stiffness loops, which need a few rows of each segment, not all of them).
+#[derive(Debug, Clone, Copy)]
+pub struct CableRows<'a> {
+    /// `ℓ_s`, m, per friction segment (`H` values; `[0]` the free length).
+    pub lengths: &'a [f64],
+    /// `w_s` of the last regime's weights (`H` values; `None` before
+    /// [`crate::compute_capstan_weights`]).
+    pub weights: Option<&'a [f64]>,
+    /// `θ_k`, rad, per hole (`H` values; the anchor's is 0).
+    pub wrap: &'a [f64],
+    entries: &'a [Entry],
+    jacobians: &'a [f64],
+    wrap_gradients: &'a [f64],
+}
+
+impl<'a> CableRows<'a> {
+    /// The number of friction segments (holes), `H`.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether the cable has no holes (never, for a built routing).
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// `J_s` of friction segment `s` ([`FrictionData::segment_jacobian`]; empty for `s ≥ H`).
+    pub fn jacobian(&self, s: usize) -> DofRow<'a> {
+        self.entries.get(s).map_or(EMPTY, |e| row(self.jacobians, &e.jacobian))
+    }
+
+    /// `∂θ_k/∂Q` of hole `k` ([`FrictionData::wrap_gradient`]; empty for the anchor and for
+    /// `k ≥ H`).
+    pub fn wrap_gradient(&self, k: usize) -> DofRow<'a> {
+        self.entries.get(k).map_or(EMPTY, |e| row(self.wrap_gradients, &e.wrap))
+    }
+
+    /// The routing segment friction segment `s` is (`None` for the free length, `s = 0`, and
+    /// for `s ≥ H`): its Hessian block is `H_s` over [`CableRows::jacobian`]'s DOFs.
+    pub fn routing_segment(&self, s: usize) -> Option<usize> {
+        self.entries.get(s).and_then(|e| e.routing)
+    }
+}
+
+const EMPTY: DofRow<'static> = DofRow { dofs: 0..0, values: &[] };
 
 /// The reusable workspace of a [`FrictionModel`] (Pinocchio's *data*): the friction geometry
 /// at one configuration and one slip regime's weights, sized once so that computing them
@@ -71,12 +134,10 @@ pub struct FrictionData {
     pub(crate) wrap_gradients: Vec<f64>,
     /// `w_s`, per entry.
     pub(crate) weights: Vec<f64>,
-    /// `∂w_s/∂Q`, per entry's weight slot.
-    pub(crate) weight_gradients: Vec<f64>,
     /// `J̃_c`, m × dof, column-major.
     pub(crate) effective_jacobian: Vec<f64>,
-    /// Scratch: `Σ_{k<s} ∂θ_k/∂Q` over the DOFs (one per DOF).
-    pub(crate) sum: Vec<f64>,
+    /// Scratch: each joint's moment `a_i × p_i` (base frame), one per DOF.
+    pub(crate) moments: Vec<[f64; 3]>,
 }
 
 impl FrictionData {
@@ -97,9 +158,8 @@ impl FrictionData {
             kinked: vec![false; n],
             wrap_gradients: vec![0.0; model.wrap_len],
             weights: vec![0.0; n],
-            weight_gradients: vec![0.0; model.weight_len],
             effective_jacobian: vec![0.0; m * model.dof],
-            sum: vec![0.0; model.dof],
+            moments: vec![[0.0; 3]; model.dof],
         }
     }
 
@@ -186,13 +246,51 @@ impl FrictionData {
     }
 
     /// `∂w_s/∂Q` of friction segment `s` of cable `c` (1/rad), over the union of the wrap rows of
-    /// holes `0 … s − 1` (empty for `s = 0`).
+    /// holes `0 … s − 1` (empty for `s = 0`): `σ μ w_s Σ_{k<s} ∂θ_k/∂Q`, the sum in hole order.
+    ///
+    /// Computed on demand from the wrap gradients and allocates its row: the evaluations do
+    /// not read these rows (the slip stiffness sums over the holes instead, module docs of
+    /// `slip.rs` in `sinew-stiffness`), checks and reports do.
     ///
     /// # Errors
     /// As [`FrictionData::weights`]; [`RoutingError::DimensionMismatch`] for `s ≥ H`.
-    pub fn weight_gradient(&self, model: &FrictionModel, c: usize, s: usize) -> Result<DofRow<'_>> {
-        self.weights_of(model, c)?;
-        Ok(row(&self.weight_gradients, &model.entry(c, s)?.weight))
+    pub fn weight_gradient(
+        &self,
+        model: &FrictionModel,
+        c: usize,
+        s: usize,
+    ) -> Result<WeightGradient> {
+        let range = self.weights_of(model, c)?;
+        let entry = model.entry(c, s)?;
+        let dofs = entry.weight.clone();
+        let mut values = vec![0.0; dofs.len()];
+        for hole in &model.entries[range.start..range.start + s] {
+            let theta = row(&self.wrap_gradients, &hole.wrap);
+            for (d, g) in theta.dofs.zip(theta.values) {
+                values[d - dofs.start] += g;
+            }
+        }
+        let rate = self.slip.map_or(0.0, Slip::sign) * model.mu[c] * self.weights[range.start + s];
+        for v in &mut values {
+            *v *= rate;
+        }
+        Ok(WeightGradient { dofs, values })
+    }
+
+    /// Cable `c`'s rows ([`CableRows`]), the workspace checked against `model` once.
+    ///
+    /// # Errors
+    /// As [`FrictionData::lengths`].
+    pub fn cable<'a>(&'a self, model: &'a FrictionModel, c: usize) -> Result<CableRows<'a>> {
+        let range = self.geometry_of(model, c)?;
+        Ok(CableRows {
+            lengths: &self.lengths[range.clone()],
+            weights: self.slip.map(|_| &self.weights[range.clone()]),
+            wrap: &self.wrap[range.clone()],
+            entries: &model.entries[range],
+            jacobians: &self.jacobians,
+            wrap_gradients: &self.wrap_gradients,
+        })
     }
 
     /// Cable `c`'s friction segments from the actuator to the anchor (`H` of them), the
@@ -212,7 +310,6 @@ impl FrictionData {
             length: self.lengths[e],
             weight: weighted.then(|| self.weights[e]),
             jacobian: row(&self.jacobians, &entry.jacobian),
-            weight_gradient: weighted.then(|| row(&self.weight_gradients, &entry.weight)),
             wrap_gradient: row(&self.wrap_gradients, &entry.wrap),
             routing_segment: entry.routing,
         }))
@@ -264,7 +361,6 @@ impl FrictionData {
             ("friction workspace (entries)", model.entries.len(), self.lengths.len()),
             ("friction workspace (Jacobian rows)", model.jacobian_len, self.jacobians.len()),
             ("friction workspace (wrap rows)", model.wrap_len, self.wrap_gradients.len()),
-            ("friction workspace (weight rows)", model.weight_len, self.weight_gradients.len()),
         ] {
             if expected != got {
                 return Err(RoutingError::WorkspaceMismatch { what, expected, got });

@@ -4,7 +4,7 @@
 use super::data::FrictionData;
 use super::model::{Entry, FrictionModel};
 use crate::error::{Result, RoutingError};
-use crate::geometry::{Kinematics, RoutingData, length_derivative, segment_vector};
+use crate::geometry::{Kinematics, RoutingData, length_derivative};
 use crate::routing::{MIN_SEGMENT_LENGTH, Routing};
 use crate::vec3::{cross, dot, rotate, scale, sub, transform};
 
@@ -46,6 +46,14 @@ pub fn compute_friction_geometry(
     data.slip = None;
     let kinematics = routing_data.kinematics();
     let segment_lengths = routing_data.segment_lengths()?;
+    // With the routing's Jacobian at hand (Order::Jacobian and above), a cable whose segments
+    // cross distinct DOFs reads each J_s from J_c.
+    let j_c = routing_data.jacobian().ok();
+    // Each joint's moment `m_i = a_i × p_i`: `(a_i × (x − p_i))·g = a_i·(x × g) − g·m_i`.
+    for (i, m) in data.moments.iter_mut().enumerate() {
+        let (axis, origin) = joint(kinematics, i, model.dof)?;
+        *m = cross(axis, origin);
+    }
     for (c, range) in model.cables.iter().enumerate() {
         let entries = &model.entries[range.clone()];
         let first = range.start;
@@ -60,12 +68,20 @@ pub fn compute_friction_geometry(
         data.directions[first] = rotate(entry_frame, &model.entry_direction[c]);
         for (s, entry) in entries.iter().enumerate().skip(1) {
             let r = entry.routing.ok_or_else(|| mismatch(model.dof))?;
-            let length = segment_lengths[r];
-            let u = segment(routing, r, entry, kinematics, &data.positions[first + s - 1..], {
-                let slot = &entry.jacobian;
-                &mut data.jacobians[slot.offset..slot.offset + slot.dofs.len()]
-            })?;
-            data.lengths[first + s] = length;
+            let slot = &entry.jacobian;
+            let jacobian = &mut data.jacobians[slot.offset..slot.offset + slot.dofs.len()];
+            let holes = [data.positions[first + s - 1], data.positions[first + s]];
+            let u = match j_c {
+                Some(j_c) if model.disjoint[c] => {
+                    // J_c over the segment's DOFs is this segment's J_s alone.
+                    for (out, i) in jacobian.iter_mut().zip(slot.dofs.clone()) {
+                        *out = j_c[(c, i)];
+                    }
+                    direction(routing, r, &holes)?
+                }
+                _ => segment(routing, r, entry, kinematics, &holes, jacobian)?,
+            };
+            data.lengths[first + s] = segment_lengths[r];
             data.directions[first + s] = u;
         }
         // Wrap angles at every hole but the anchor.
@@ -84,20 +100,47 @@ pub fn compute_friction_geometry(
             }
             let n = scale(&w, 1.0 / sine);
             let (g_in, g_out) = (cross(&n, &u_in), cross(&n, &u_out));
-            let holes = &data.positions[if k == 0 { e } else { e - 1 }..=e + 1];
-            let bodies = [entries[k.saturating_sub(1)].hole_body, entries[k].hole_body];
-            let ends = Ends { holes, bodies, out_body: entries[k + 1].hole_body, first: k == 0 };
-            let lengths = (data.lengths[e], data.lengths[e + 1]);
-            for (j, i) in slot.dofs.clone().enumerate() {
-                let (axis, origin) = joint(kinematics, i, model.dof)?;
-                let incoming = if k == 0 {
-                    // The entry direction turns with hole 0's body.
-                    if i < entries[0].hole_body { dot(&cross(axis, &u_in), &g_in) } else { 0.0 }
-                } else {
-                    dot(&ends.in_motion(axis, origin, i), &g_in) / lengths.0
+            let at = data.positions[e];
+            let (next, b_next) = (data.positions[e + 1], entries[k + 1].hole_body);
+            let b_at = entries[k].hole_body;
+            // Incoming: the entry direction turns with hole 0's body (k = 0), else the segment
+            // from hole k − 1: `∂d_in/∂q_i · g_in = term(h_k) − term(h_{k−1})` per moving end.
+            let incoming = if k == 0 {
+                Incoming::Entry(cross(&u_in, &g_in))
+            } else {
+                let (before, b_before) = (data.positions[e - 1], entries[k - 1].hole_body);
+                Incoming::Segment {
+                    at: cross(&at, &g_in),
+                    before: cross(&before, &g_in),
+                    bodies: [b_before, b_at],
+                    scale: 1.0 / data.lengths[e],
+                }
+            };
+            let (out_at, out_next) = (cross(&at, &g_out), cross(&next, &g_out));
+            let out_scale = 1.0 / data.lengths[e + 1];
+            for (out, i) in gradient.iter_mut().zip(slot.dofs.clone()) {
+                let (axis, _) = joint(kinematics, i, model.dof)?;
+                let m = data.moments.get(i).ok_or_else(|| mismatch(model.dof))?;
+                let (gm_in, gm_out) = (dot(&g_in, m), dot(&g_out, m));
+                let into = match &incoming {
+                    Incoming::Entry(v) => {
+                        if i < b_at {
+                            dot(axis, v)
+                        } else {
+                            0.0
+                        }
+                    }
+                    Incoming::Segment { at, before, bodies: [b_before, b_at], scale } => {
+                        let moved = |x: &[f64; 3], b: usize| {
+                            if i < b { dot(axis, x) - gm_in } else { 0.0 }
+                        };
+                        (moved(at, *b_at) - moved(before, *b_before)) * scale
+                    }
                 };
-                let outgoing = dot(&ends.out_motion(axis, origin, i), &g_out) / lengths.1;
-                gradient[j] = outgoing - incoming;
+                let moved =
+                    |x: &[f64; 3], b: usize| if i < b { dot(axis, x) - gm_out } else { 0.0 };
+                let outgoing = (moved(&out_next, b_next) - moved(&out_at, b_at)) * out_scale;
+                *out = outgoing - into;
             }
         }
         data.wrap[first + entries.len() - 1] = 0.0;
@@ -107,93 +150,58 @@ pub fn compute_friction_geometry(
     Ok(())
 }
 
+/// What turns the incoming direction at a hole: the entry direction (hole 0: `u_0 × g_in`,
+/// turned by every joint before hole 0's body), or the segment from the hole before
+/// (`h × g_in` at both its ends, their bodies, and `1/ℓ_in`).
+enum Incoming {
+    Entry([f64; 3]),
+    Segment { at: [f64; 3], before: [f64; 3], bodies: [usize; 2], scale: f64 },
+}
+
+/// Routing segment `r`'s unit direction away from the actuator from its two holes `holes`
+/// (base frame, in cable order), checked for length as the routing checks it.
+fn direction(routing: &Routing, r: usize, holes: &[[f64; 3]; 2]) -> Result<[f64; 3]> {
+    let d = sub(&holes[1], &holes[0]);
+    let length = dot(&d, &d).sqrt();
+    if length.is_nan() || length < MIN_SEGMENT_LENGTH {
+        let seg = &routing.segments[r];
+        return Err(RoutingError::DegenerateSegment {
+            cable: routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default(),
+            segment: seg.index,
+            length,
+            min: MIN_SEGMENT_LENGTH,
+        });
+    }
+    Ok(scale(&d, 1.0 / length))
+}
+
 /// Friction segment `entry` (routing segment `r`): its unit direction away from the actuator,
-/// and `J_s` written into `jacobian`. `holes` starts at the segment's first hole (base frame).
+/// and `J_s` written into `jacobian` by the routing's own formula (for a cable with two
+/// segments across one DOF, where `J_c` holds their sum). `holes` are the segment's two holes
+/// in cable order (base frame).
 fn segment(
     routing: &Routing,
     r: usize,
     entry: &Entry,
-    (frames, axes, origins): Kinematics<'_>,
-    holes: &[[f64; 3]],
+    (_, axes, origins): Kinematics<'_>,
+    holes: &[[f64; 3]; 2],
     jacobian: &mut [f64],
 ) -> Result<[f64; 3]> {
     let seg = &routing.segments[r];
-    let dof = routing.dof;
-    let degenerate = |length: f64| RoutingError::DegenerateSegment {
-        cable: routing.cables.get(seg.cable).map(|c| c.name.clone()).unwrap_or_default(),
-        segment: seg.index,
-        length,
-        min: MIN_SEGMENT_LENGTH,
-    };
+    let u = direction(routing, r, holes)?;
     if seg.dofs.is_empty() {
-        // Within one body: a constant length, a direction that turns with the body.
-        let d = sub(&holes[1], &holes[0]);
-        let length = dot(&d, &d).sqrt();
-        if length.is_nan() || length < MIN_SEGMENT_LENGTH {
-            return Err(degenerate(length));
-        }
-        return Ok(scale(&d, 1.0 / length));
+        return Ok(u);
     }
-    let (Some(frame_a), Some(frame_b)) =
-        (frames.get(seg.proximal.body), frames.get(seg.distal.body))
-    else {
-        return Err(mismatch(dof));
-    };
-    // The routing's own formula for the segment (proximal body to distal body), so that J_s is
-    // its share of J_c bit for bit; turned to point away from the actuator after.
-    let (o_p_b, d, length) = segment_vector(frame_a, frame_b, seg);
-    if length.is_nan() || length < MIN_SEGMENT_LENGTH {
-        return Err(degenerate(length));
-    }
-    let u = scale(&d, 1.0 / length);
+    // The routing's formula on its own orientation (proximal to distal body).
+    let (o_p_b, u_seg) = if entry.reversed { (holes[0], scale(&u, -1.0)) } else { (holes[1], u) };
     let lo = seg.dofs.start;
     for (k, out) in jacobian.iter_mut().enumerate() {
         let (Some(a), Some(p)) = (axes.get(lo + k), origins.get(lo + k)) else {
-            return Err(mismatch(dof));
+            return Err(mismatch(routing.dof));
         };
-        *out = length_derivative(a, p, &o_p_b, &u).1;
+        *out = length_derivative(a, p, &o_p_b, &u_seg).1;
     }
-    Ok(if entry.reversed { scale(&u, -1.0) } else { u })
-}
-
-/// The three holes around hole `k` (base frame) and what moves them, for `∂d/∂q_i` of the
-/// segments arriving at (`d_in = hole_k − hole_{k−1}`) and leaving (`d_out = hole_{k+1} −
-/// hole_k`) hole `k`.
-struct Ends<'a> {
-    /// Holes `k − 1, k, k + 1` (`k, k + 1` when `first`).
-    holes: &'a [[f64; 3]],
-    /// Bodies of holes `k − 1` and `k` (both hole 0's when `first`).
-    bodies: [usize; 2],
-    /// Body of hole `k + 1`.
-    out_body: usize,
-    /// Whether `k = 0` (no segment arrives: the entry direction does).
-    first: bool,
-}
-
-impl Ends<'_> {
-    /// `∂d_in/∂q_i` (not used when `first`).
-    fn in_motion(&self, axis: &[f64; 3], origin: &[f64; 3], i: usize) -> [f64; 3] {
-        let (before, at) = (&self.holes[0], &self.holes[1]);
-        sub(
-            &motion(axis, origin, i, at, self.bodies[1]),
-            &motion(axis, origin, i, before, self.bodies[0]),
-        )
-    }
-
-    /// `∂d_out/∂q_i`.
-    fn out_motion(&self, axis: &[f64; 3], origin: &[f64; 3], i: usize) -> [f64; 3] {
-        let at = usize::from(!self.first);
-        let (hole, next) = (&self.holes[at], &self.holes[at + 1]);
-        sub(
-            &motion(axis, origin, i, next, self.out_body),
-            &motion(axis, origin, i, hole, self.bodies[1]),
-        )
-    }
-}
-
-/// `∂o_p/∂q_i = a_i × (o_p − p_i)` for a hole on `body` (0 unless joint `i` moves it: `i < body`).
-fn motion(axis: &[f64; 3], origin: &[f64; 3], i: usize, hole: &[f64; 3], body: usize) -> [f64; 3] {
-    if i < body { cross(axis, &sub(hole, origin)) } else { [0.0; 3] }
+    Ok(u)
 }
 
 /// Joint `i`'s axis and origin (base frame).

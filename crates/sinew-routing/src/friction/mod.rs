@@ -60,7 +60,8 @@
 //! layout of every row and each cable's μ and entry direction) and [`FrictionData`] (the
 //! workspace, sized once). [`compute_friction_geometry`] reads the kinematics a
 //! [`crate::RoutingData`] holds from its last evaluation; [`compute_capstan_weights`] then
-//! gives one regime's weights. Neither allocates. Layout: `model.rs`, workspace and its
+//! gives one regime's weights (`∂w_s/∂Q` is not stored: [`FrictionData::weight_gradient`]
+//! computes it on demand). Neither allocates. Layout: `model.rs`, workspace and its
 //! accessors: `data.rs`, the geometry: `geometry.rs`, the weights: `weights.rs`.
 
 mod data;
@@ -68,7 +69,7 @@ mod geometry;
 mod model;
 mod weights;
 
-pub use data::{DofRow, FrictionData, SegmentRows};
+pub use data::{CableRows, DofRow, FrictionData, SegmentRows, WeightGradient};
 pub use geometry::{WRAP_KINK, compute_friction_geometry};
 pub use model::{FrictionModel, Slip};
 pub use weights::compute_capstan_weights;

@@ -64,8 +64,8 @@ pub(crate) struct Entry {
     pub(crate) hole_point: [f64; 3],
     /// `∂θ_s/∂Q` at hole `s` (empty for the anchor).
     pub(crate) wrap: Slot,
-    /// `∂w_s/∂Q`: the union of the wrap rows of holes `0 … s−1`.
-    pub(crate) weight: Slot,
+    /// The DOFs of `∂w_s/∂Q`: the union of the wrap rows of holes `0 … s−1`.
+    pub(crate) weight: Range<usize>,
 }
 
 /// The immutable description of a routing's friction geometry (Pinocchio's *model*): built once
@@ -88,9 +88,11 @@ pub struct FrictionModel {
     pub(crate) entry_direction: Vec<[f64; 3]>,
     /// Each cable's free length, m.
     pub(crate) free_length: Vec<f64>,
+    /// Per cable: whether no two of its segments cross the same DOF, so that each `J_s` is
+    /// `J_c` over the segment's DOFs (the routing's own values, bit for bit).
+    pub(crate) disjoint: Vec<bool>,
     pub(crate) jacobian_len: usize,
     pub(crate) wrap_len: usize,
-    pub(crate) weight_len: usize,
 }
 
 impl FrictionModel {
@@ -99,7 +101,7 @@ impl FrictionModel {
     pub fn new(routing: &Routing) -> FrictionModel {
         let mut entries = Vec::with_capacity(routing.segments.len() + routing.cables.len());
         let mut cables = Vec::with_capacity(routing.cables.len());
-        let (mut jacobian_len, mut wrap_len, mut weight_len) = (0, 0, 0);
+        let (mut jacobian_len, mut wrap_len) = (0, 0);
         for cable in &routing.cables {
             let first = entries.len();
             let holes = &cable.holes;
@@ -113,7 +115,7 @@ impl FrictionModel {
                         (Some(r), body(k - 1) > body(k), routing.segments[r].dofs.clone())
                     }
                 };
-                let weight = Slot::push(union.clone().unwrap_or(0..0), &mut weight_len);
+                let weight = union.clone().unwrap_or(0..0);
                 // The bodies whose joints can change θ_k: those of holes k − 1 (none before the
                 // first: the entry direction turns with hole 0's body), k and k + 1.
                 let wrap_dofs = if k + 1 < holes.len() {
@@ -155,9 +157,13 @@ impl FrictionModel {
                 .map(|c| [c.entry_in_body.x, c.entry_in_body.y, c.entry_in_body.z])
                 .collect(),
             free_length: routing.cables.iter().map(|c| c.free_length).collect(),
+            disjoint: routing
+                .cables
+                .iter()
+                .map(|c| disjoint(&routing.segments[c.segments.clone()]))
+                .collect(),
             jacobian_len,
             wrap_len,
-            weight_len,
         }
     }
 
@@ -259,4 +265,13 @@ impl FrictionModel {
         }
         Ok(())
     }
+}
+
+/// Whether no two of `segments` (one cable's) cross the same DOF.
+fn disjoint(segments: &[crate::routing::Segment]) -> bool {
+    let crossing = |s: &&crate::routing::Segment| !s.dofs.is_empty();
+    segments.iter().filter(crossing).enumerate().all(|(i, a)| {
+        let later = segments.iter().filter(crossing).skip(i + 1);
+        later.into_iter().all(|b| a.dofs.end <= b.dofs.start || b.dofs.end <= a.dofs.start)
+    })
 }

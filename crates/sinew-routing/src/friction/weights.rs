@@ -1,4 +1,4 @@
-//! One slip regime's capstan weights, their gradients and the effective cable Jacobian, from
+//! One slip regime's capstan weights and the effective cable Jacobian, from
 //! the friction geometry (module docs of `crate::friction`).
 
 use super::data::FrictionData;
@@ -6,13 +6,13 @@ use super::model::{FrictionModel, Slip};
 use crate::error::{Result, RoutingError};
 
 /// The capstan weights of `slip` from the friction geometry in `data`
-/// ([`crate::compute_friction_geometry`]): per cable `w_s` and `∂w_s/∂Q`, and the effective
+/// ([`crate::compute_friction_geometry`]): per cable `w_s`, and the effective
 /// cable Jacobian `J̃_c = Σ_s w_s J_s` (m × dof). Allocates nothing; may be called for each
 /// regime in turn on one geometry.
 ///
 /// # Math
 /// `w_0 = 1`, `w_s = w_{s−1} e^{σ μ θ_{s−1}}` (`σ` = [`Slip::sign`]: −1 pull, +1 release; `μ`
-/// the cable's), `∂w_s/∂Q = σ μ w_s Σ_{k<s} ∂θ_k/∂Q`, `J̃_c = Σ_{s ≥ 1} w_s J_s` summed in
+/// the cable's), `J̃_c = Σ_{s ≥ 1} w_s J_s` summed in
 /// segment order from 0. At μ = 0 every `w_s` is exactly 1 and `J̃_c` is `J_c` bit for bit.
 ///
 /// # Errors
@@ -37,23 +37,11 @@ pub fn compute_capstan_weights(
         let entries = &model.entries[range.clone()];
         let first = range.start;
         let rate = slip.sign() * model.mu[c];
-        // The running sum Σ_{k<s} ∂θ_k/∂Q over the DOFs the last weight's row covers.
-        let all = &entries[entries.len() - 1].weight.dofs;
-        data.sum[all.clone()].fill(0.0);
         data.weights[first] = 1.0;
         for s in 1..entries.len() {
-            let (e, hole) = (first + s, &entries[s - 1].wrap);
+            let e = first + s;
             let w = data.weights[e - 1] * (rate * data.wrap[e - 1]).exp();
             data.weights[e] = w;
-            let theta = &data.wrap_gradients[hole.offset..hole.offset + hole.dofs.len()];
-            for (sum, g) in data.sum[hole.dofs.clone()].iter_mut().zip(theta) {
-                *sum += g;
-            }
-            let slot = &entries[s].weight;
-            let out = &mut data.weight_gradients[slot.offset..slot.offset + slot.dofs.len()];
-            for (out, sum) in out.iter_mut().zip(&data.sum[slot.dofs.clone()]) {
-                *out = rate * w * sum;
-            }
             let row = &entries[s].jacobian;
             let j_s = &data.jacobians[row.offset..row.offset + row.dofs.len()];
             for (i, g) in row.dofs.clone().zip(j_s) {

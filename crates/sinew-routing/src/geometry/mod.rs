@@ -36,7 +36,7 @@ use crate::error::{Result, RoutingError};
 use crate::routing::{Routing, Segment, check_shape, rigid_length};
 
 pub use compute::{compute_cable_geometry, compute_cable_geometry_from_kinematics};
-pub(crate) use segment::{Kinematics, length_derivative, segment_vector};
+pub(crate) use segment::{Kinematics, length_derivative};
 
 /// What an evaluation computes; each order includes the ones before it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -303,6 +303,15 @@ impl<'a> SegmentHessians<'a> {
     #[inline]
     pub fn get(&self, s: usize) -> Option<MatRef<'a, f64>> {
         hessian_block(self.routing, self.hessians, s)
+    }
+
+    /// Segment `s`'s Hessian block as [`SegmentHessians::get`] gives it, as its column-major
+    /// entries (`|dofs|²` of them); `None` when `s` is out of range.
+    #[inline]
+    pub fn entries(&self, s: usize) -> Option<&'a [f64]> {
+        let seg = self.routing.segments.get(s)?;
+        let n = seg.dofs.len();
+        self.hessians.get(seg.hessian_offset..seg.hessian_offset + n * n)
     }
 
     /// The blocks batch by batch, when the routing is batched ([`Routing::is_batched`]) and no

@@ -150,7 +150,7 @@ fn segment_derivatives_any(
 /// needs a segment's vector (this file's, and the friction geometry's, which must give the
 /// same `J_c` bit for bit).
 #[inline(always)]
-pub(crate) fn segment_vector(
+fn segment_vector(
     frame_a: &[f64; 12],
     frame_b: &[f64; 12],
     seg: &Segment,
