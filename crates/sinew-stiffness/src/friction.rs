@@ -16,12 +16,11 @@
 //! affine in the actuator tensions for a given regime (and history).
 
 use faer::MatRef;
-use sinew_routing::{
-    CableRows, FrictionData, FrictionModel, Routing, RoutingError, SegmentHessians, Slip,
-};
+use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
+use crate::joint::{Weights, add_weighted_hessians};
 
 /// How the segment tensions of a sticking cable were left (spec §9): the distribution of the
 /// last slip, or equal tensions along each cable.
@@ -74,6 +73,8 @@ pub struct FrictionStiffnessData {
     pub(crate) series_elastic: ColMajor,
     /// Scratch (slip), dof × m: column `c` is `T_0 g_c / C̃_c`, `g_c = Σ_s c_s ∂w_s/∂Q`.
     pub(crate) moving_series_t: ColMajor,
+    /// Scratch, one per routing segment: its tension `T_s` (the weight of its Hessian).
+    pub(crate) segment_tensions: Vec<f64>,
     /// Scratch (slip), one per DOF: the running sum `G_k = σμ T_0 Σ_{s>k} w_s J_s` of one
     /// cable (zero between cables).
     pub(crate) suffix: Vec<f64>,
@@ -95,6 +96,7 @@ impl FrictionStiffnessData {
             series_elastic: ColMajor::zeros(m, n),
             moving_series_t: ColMajor::zeros(n, m),
             suffix: vec![0.0; n],
+            segment_tensions: vec![0.0; model.routing_segment_count()],
         }
     }
 
@@ -213,40 +215,28 @@ impl FrictionStiffnessData {
     }
 }
 
-/// `out[dofs, dofs] += scale · H_s` for friction segment `s` of `cable` (the routing's segment
-/// Hessian from `hessians`, over `J_s`'s DOFs, entry by entry column by column: the order of
-/// `RoutingData::add_weighted_hessians`); nothing for the free length.
-#[inline]
-pub(crate) fn add_segment_hessian(
-    (routing, hessians): (&Routing, &SegmentHessians<'_>),
-    (cable, s): (&CableRows<'_>, usize),
-    scale: f64,
-    out: &mut ColMajor,
+/// `K_c = Σ_c Σ_s T_{c,s} H_{c,s}` into `out.controllable` (zeros before), with each segment's
+/// tension `T_s = T_0 · weight(c, s)` (`weight(c, s)` the weight of friction segment `s ≥ 1` of
+/// cable `c`). Summed as the frictionless `Σ_c f_c H_c` is (batch by batch on a batched
+/// routing, else segment by segment), so that weights of exactly 1 give its bits.
+pub(crate) fn add_segment_hessians(
+    (model, routing, geometry): (&FrictionModel, &Routing, &RoutingData),
+    friction: &FrictionData,
+    actuator: &[f64],
+    weight: impl Fn(&CableRows<'_>, usize) -> f64,
+    out: &mut FrictionStiffnessData,
 ) -> Result<(), StiffnessError> {
-    let Some(r) = cable.routing_segment(s) else {
-        return Ok(());
-    };
-    let Some(h) = hessians.entries(r) else {
-        let expected = routing.segments().len();
-        return Err(
-            RoutingError::DimensionMismatch { what: "segment index", expected, got: r }.into()
-        );
-    };
-    let dofs = cable.jacobian(s).dofs;
-    let n = dofs.len();
-    if n == 0 {
-        return Ok(());
-    }
-    // Blocks are 2 × 2 to 4 × 4: plain index loops (an iterator chain here vectorises for
-    // long columns and pays its dispatch on every tiny block).
-    for k in 0..n {
-        let column = &mut out.col_mut(dofs.start + k)[dofs.clone()];
-        let h = &h[k * n..(k + 1) * n];
-        for i in 0..n {
-            column[i] += scale * h[i];
+    let FrictionStiffnessData { segment_tensions, controllable, .. } = out;
+    for (c, &t_0) in actuator.iter().enumerate() {
+        let cable = friction.cable(model, c)?;
+        for s in 1..cable.len() {
+            if let Some(t) = cable.routing_segment(s).and_then(|r| segment_tensions.get_mut(r)) {
+                *t = t_0 * weight(&cable, s);
+            }
         }
     }
-    Ok(())
+    let hessians = geometry.segment_hessians(routing)?;
+    add_weighted_hessians(routing, hessians, Weights::Segment(segment_tensions), controllable)
 }
 
 /// The capstan weights of `slip` in `friction`, checked to be that regime's.

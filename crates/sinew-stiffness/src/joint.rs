@@ -101,12 +101,15 @@ pub(crate) fn joint_stiffness_in_blocks(
         let hessians = geometry.segment_hessians(routing)?;
         match hessians.batches() {
             // Each batch's block written once (the rest of K_c is never written: zero).
-            Some(batches) => {
-                add_weighted_hessians_batched(routing, batches, tensions, controllable)?
-            }
+            Some(batches) => add_weighted_hessians_batched(
+                routing,
+                batches,
+                Weights::Cable(tensions),
+                controllable,
+            )?,
             None => {
                 zero_blocks(layout, controllable);
-                add_weighted_hessians(routing, hessians, tensions, controllable)?;
+                add_weighted_hessians(routing, hessians, Weights::Cable(tensions), controllable)?;
             }
         }
         // Every entry the tiles reach is written once; the others are never written (zero).
@@ -243,28 +246,55 @@ fn add_inherent_upper(
     Ok(())
 }
 
-/// `out += Σ_c f_c H_c` segment by segment, each block column by column: the sums of
-/// [`RoutingData::add_weighted_hessians`] in the same order, written through column slices.
-fn add_weighted_hessians(
+/// The weight of each segment's Hessian in a sum `Σ w H`: its cable's tension (`Σ_c f_c H_c`,
+/// eq. 14) or one per segment (the friction regimes' segment tensions `T_s`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Weights<'a> {
+    /// `w = f_c` of the segment's cable (one per cable).
+    Cable(&'a [f64]),
+    /// `w = T_s`, one per segment of [`Routing::segments`].
+    Segment(&'a [f64]),
+}
+
+impl Weights<'_> {
+    /// The weight of segment `s` of cable `c`.
+    #[inline(always)]
+    fn get(&self, c: usize, s: usize) -> Option<f64> {
+        match self {
+            Weights::Cable(w) => w.get(c).copied(),
+            Weights::Segment(w) => w.get(s).copied(),
+        }
+    }
+
+    fn mismatch(&self, routing: &Routing) -> StiffnessError {
+        let (what, expected, got) = match self {
+            Weights::Cable(w) => ("tensions", routing.cable_count(), w.len()),
+            Weights::Segment(w) => ("segment tensions", routing.segments().len(), w.len()),
+        };
+        StiffnessError::DimensionMismatch { what, expected, got }
+    }
+}
+
+/// `out += Σ_s w_s H_s` segment by segment, each block column by column: the sums of
+/// [`RoutingData::add_weighted_hessians`] in the same order (with `w_s = f_c`), written through
+/// column slices. Batched routings go batch by batch ([`add_weighted_hessians_batched`]: each
+/// block overwritten, so `out` must hold zeros there).
+pub(crate) fn add_weighted_hessians(
     routing: &Routing,
     hessians: SegmentHessians<'_>,
-    tensions: &[f64],
+    weights: Weights<'_>,
     out: &mut ColMajor,
 ) -> Result<(), StiffnessError> {
     if let Some(batches) = hessians.batches() {
-        return add_weighted_hessians_batched(routing, batches, tensions, out);
+        return add_weighted_hessians_batched(routing, batches, weights, out);
     }
     for (s, (seg, h)) in hessians.iter().enumerate() {
         let (lo, n) = (seg.dofs.start, seg.dofs.len());
         if n == 0 {
             continue;
         }
-        let Some(&w) = tensions.get(seg.cable) else {
-            return Err(StiffnessError::DimensionMismatch {
-                what: "tensions",
-                expected: routing.cable_count(),
-                got: tensions.len(),
-            });
+        let Some(w) = weights.get(seg.cable, s) else {
+            return Err(weights.mismatch(routing));
         };
         if h.len() != n * n || lo + n > out.rows() || lo + n > out.cols() {
             return Err(StiffnessError::DimensionMismatch {
@@ -302,17 +332,13 @@ fn add_weighted_hessians(
 fn add_weighted_hessians_batched<'a>(
     routing: &Routing,
     batches: impl Iterator<Item = HessianBatch<'a>>,
-    tensions: &[f64],
+    weights: Weights<'_>,
     out: &mut ColMajor,
 ) -> Result<(), StiffnessError> {
-    let tension_mismatch = || StiffnessError::DimensionMismatch {
-        what: "tensions",
-        expected: routing.cable_count(),
-        got: tensions.len(),
-    };
     for batch in batches {
         let (lo, n) = (batch.dofs.start, batch.dofs.len());
         if batch.blocks.len() != batch.cables.len() * n * n
+            || batch.segments.len() != batch.cables.len()
             || lo + n > out.rows()
             || lo + n > out.cols()
         {
@@ -322,10 +348,11 @@ fn add_weighted_hessians_batched<'a>(
                 got: batch.blocks.len(),
             });
         }
+        let entries = batch.cables.iter().zip(batch.segments);
         if n == 2 {
             let mut acc = [0.0; 4];
-            for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(4)) {
-                let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
+            for ((&c, &r), h) in entries.zip(batch.blocks.chunks_exact(4)) {
+                let w = weights.get(c, r).ok_or_else(|| weights.mismatch(routing))?;
                 for t in 0..4 {
                     acc[t] += w * h[t];
                 }
@@ -337,8 +364,8 @@ fn add_weighted_hessians_batched<'a>(
         for k in lo..lo + n {
             out.col_mut(k)[lo..lo + n].fill(0.0);
         }
-        for (&c, h) in batch.cables.iter().zip(batch.blocks.chunks_exact(n * n)) {
-            let w = *tensions.get(c).ok_or_else(tension_mismatch)?;
+        for ((&c, &r), h) in entries.zip(batch.blocks.chunks_exact(n * n)) {
+            let w = weights.get(c, r).ok_or_else(|| weights.mismatch(routing))?;
             for (k, h) in h.chunks_exact(n).enumerate() {
                 let col = &mut out.col_mut(lo + k)[lo..lo + n];
                 for (v, h) in col.iter_mut().zip(h) {

@@ -58,11 +58,11 @@
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Par};
-use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData, Slip};
+use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
 use crate::error::StiffnessError;
 use crate::friction::{
-    FrictionRegime, FrictionStiffnessData, add_segment_hessian, axial_rigidity, check_weights,
+    FrictionRegime, FrictionStiffnessData, add_segment_hessians, axial_rigidity, check_weights,
 };
 
 /// The joint stiffness of the slip regime `slip` at the actuator tensions `actuator` (m, N),
@@ -96,14 +96,9 @@ pub fn slip_stiffness(
     let j_c = geometry.jacobian()?;
     // Pass 1, every cable: Σ_s T_0 w_s H_s (w_s = 1 exactly at μ = 0: today's Σ f_c H_c in its
     // order); the μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal, then mirrored.
-    let hessians = (routing, &geometry.segment_hessians(routing)?);
-    for (c, &t_0) in actuator.iter().enumerate() {
-        let cable = friction.cable(model, c)?;
-        let weights = cable.weights.unwrap_or(&[]);
-        for s in 1..cable.len() {
-            let w = weights.get(s).copied().unwrap_or(1.0);
-            add_segment_hessian(hessians, (&cable, s), t_0 * w, &mut out.controllable)?;
-        }
+    let weight = |cable: &CableRows<'_>, s: usize| cable.weights.map_or(1.0, |w| w[s]);
+    add_segment_hessians((model, routing, geometry), friction, actuator, weight, out)?;
+    for (c, _) in actuator.iter().enumerate() {
         if mu[c] == 0.0 {
             let cable = &routing.cables()[c];
             let k = cable.stiffness;

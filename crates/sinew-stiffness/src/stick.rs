@@ -1,11 +1,11 @@
 //! The stick regime's joint stiffness (spec §9, #27): no hole slides, each segment a spring of
 //! its own.
 
-use sinew_routing::{FrictionData, FrictionModel, Routing, RoutingData};
+use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData};
 
 use crate::error::StiffnessError;
 use crate::friction::{
-    FrictionRegime, FrictionStiffnessData, History, add_segment_hessian, axial_rigidity,
+    FrictionRegime, FrictionStiffnessData, History, add_segment_hessians, axial_rigidity,
     check_weights,
 };
 
@@ -57,15 +57,14 @@ pub fn stick_stiffness(
         check_weights(friction, slip)?;
     }
     let ea = axial_rigidity(routing);
-    let hessians = (routing, &geometry.segment_hessians(routing)?);
-    for (c, &t_0) in actuator.iter().enumerate() {
+    let weight = |cable: &CableRows<'_>, s: usize| match (history, cable.weights) {
+        (History::Pull | History::Release, Some(w)) => w[s],
+        _ => 1.0,
+    };
+    add_segment_hessians((model, routing, geometry), friction, actuator, weight, out)?;
+    for c in 0..actuator.len() {
         let cable = friction.cable(model, c)?;
         for s in 1..cable.len() {
-            let t_s = match (history, cable.weights) {
-                (History::Pull | History::Release, Some(w)) => t_0 * w[s],
-                _ => t_0,
-            };
-            add_segment_hessian(hessians, (&cable, s), t_s, &mut out.controllable)?;
             // J_sᵀ k_s J_s on and above the diagonal (mirrored below once every cable is in).
             let j_s = cable.jacobian(s);
             let k_s = ea / cable.lengths[s];

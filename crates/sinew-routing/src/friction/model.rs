@@ -190,6 +190,11 @@ impl FrictionModel {
         self.dof
     }
 
+    /// Number of segments of the routing it was built for ([`Routing::segments`]).
+    pub fn routing_segment_count(&self) -> usize {
+        self.routing_segments
+    }
+
     /// Number of cables.
     pub fn cable_count(&self) -> usize {
         self.cables.len()

@@ -293,6 +293,8 @@ pub struct HessianBatch<'a> {
     pub dofs: std::ops::Range<usize>,
     /// Each segment's cable, in routing order.
     pub cables: &'a [usize],
+    /// Each segment's index in [`Routing::segments`], in the same order.
+    pub segments: &'a [usize],
     /// The segments' `|dofs| × |dofs|` Hessian blocks (column-major), one after the other.
     pub blocks: &'a [f64],
 }
@@ -328,6 +330,7 @@ impl<'a> SegmentHessians<'a> {
             HessianBatch {
                 dofs: b.proximal..b.distal,
                 cables: plan.cable.get(b.entries.clone()).unwrap_or(&[]),
+                segments: plan.segment.get(b.entries.clone()).unwrap_or(&[]),
                 blocks: hessians.get(o..o + b.entries.len() * n * n).unwrap_or(&[]),
             }
         }))
