@@ -197,12 +197,16 @@ pub fn slip_levels(
     sizes(&[("equilibrium torques T0", dof, t0.len())])?;
     let (alpha, beta): (Vec<f64>, Vec<f64>) =
         actuator.iter().map(|&a| limit_scaling(a, limits)).unzip();
-    let scaled = Mat::from_fn(m, dof, |c, k| j_tilde[(c, k)] * alpha[c]);
-    let shifted: Vec<f64> = t0
-        .iter()
-        .enumerate()
-        .map(|(k, t)| t + (0..m).map(|c| j_tilde[(c, k)] * beta[c]).sum::<f64>())
-        .collect();
+    // `J̃ diag(α)` and `T0 + J̃ᵀ β`, column by column (J̃'s columns are contiguous).
+    let mut scaled = Mat::<f64>::zeros(m, dof);
+    let mut shifted = t0.to_vec();
+    for (k, shift) in shifted.iter_mut().enumerate() {
+        let column = j_tilde.col(k);
+        for ((out, j), a) in scaled.col_mut(k).iter_mut().zip(column.iter()).zip(&alpha) {
+            *out = j * a;
+        }
+        *shift += column.iter().zip(&beta).map(|(j, b)| j * b).sum::<f64>();
+    }
     // Level 0 is the least total of `T`, not of `g`: where the joint's null direction in `g`
     // (oriented to a non-negative sum, as the closed form does) has a negative sum once scaled
     // by `α`, its interval runs the other way in `T`, and the level is mirrored.

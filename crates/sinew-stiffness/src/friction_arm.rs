@@ -52,6 +52,8 @@ pub struct FrictionArmData {
     pub segments: Vec<Vec<f64>>,
     /// Per cable, the dead band `[T₀^release, T₀^pull]` of its anchor tension (N).
     pub dead_band: Vec<[f64; 2]>,
+    /// Per cable, the anchor tension the dead band is computed for (N).
+    anchor: Vec<f64>,
     /// The end's verdict (`None` before an evaluation).
     pub outcome: Option<EndOutcome>,
 }
@@ -67,6 +69,7 @@ impl FrictionArmData {
             actuator: vec![0.0; m],
             segments: vec![Vec::new(); m],
             dead_band: vec![[0.0; 2]; m],
+            anchor: vec![0.0; m],
             outcome: None,
         }
     }
@@ -127,9 +130,10 @@ impl ArmStiffness {
                 Some(_) => segments.extend(out.friction.weights(model, c)?.iter().map(|w| t_0 * w)),
             }
         }
-        let anchor: Vec<f64> =
-            out.segments.iter().map(|s| s.last().copied().unwrap_or(0.0)).collect();
-        dead_band(model, &out.friction, &anchor, &mut out.dead_band)?;
+        for (a, s) in out.anchor.iter_mut().zip(&out.segments) {
+            *a = s.last().copied().unwrap_or(0.0);
+        }
+        dead_band(model, &out.friction, &out.anchor, &mut out.dead_band)?;
         let geometry = &data.cables;
         match regime {
             FrictionRegime::Slip(slip) => {
