@@ -20,7 +20,7 @@ use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
-use crate::joint::{Weights, add_weighted_hessians};
+use crate::hessian_sums::{Weights, add_weighted_hessians};
 
 /// How the segment tensions of a sticking cable were left (spec §9): the distribution of the
 /// last slip, or equal tensions along each cable.

@@ -21,10 +21,11 @@ use std::ops::Range;
 
 use faer::{MatMut, MatRef};
 use nalgebra::Matrix2;
-use sinew_routing::{HessianBatch, Routing, RoutingData, SegmentHessians};
+use sinew_routing::{Routing, RoutingData, SegmentHessians};
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
+use crate::hessian_sums::{Weights, add_weighted_hessians, add_weighted_hessians_batched};
 use crate::inherent::{InherentPlan, InherentScratch};
 use crate::structured::{BlockLayout, MAX_BLOCK, zero_blocks};
 
@@ -240,137 +241,6 @@ fn add_inherent_upper(
             let kj = k * j_c[(c, j)];
             for i in cable.dofs.start..=j {
                 out[(i, j)] += kj * j_c[(c, i)];
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The weight of each segment's Hessian in a sum `Σ w H`: its cable's tension (`Σ_c f_c H_c`,
-/// eq. 14) or one per segment (the friction regimes' segment tensions `T_s`).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Weights<'a> {
-    /// `w = f_c` of the segment's cable (one per cable).
-    Cable(&'a [f64]),
-    /// `w = T_s`, one per segment of [`Routing::segments`].
-    Segment(&'a [f64]),
-}
-
-impl Weights<'_> {
-    /// The weight of segment `s` of cable `c`.
-    #[inline(always)]
-    fn get(&self, c: usize, s: usize) -> Option<f64> {
-        match self {
-            Weights::Cable(w) => w.get(c).copied(),
-            Weights::Segment(w) => w.get(s).copied(),
-        }
-    }
-
-    fn mismatch(&self, routing: &Routing) -> StiffnessError {
-        let (what, expected, got) = match self {
-            Weights::Cable(w) => ("tensions", routing.cable_count(), w.len()),
-            Weights::Segment(w) => ("segment tensions", routing.segments().len(), w.len()),
-        };
-        StiffnessError::DimensionMismatch { what, expected, got }
-    }
-}
-
-/// `out += Σ_s w_s H_s` segment by segment, each block column by column: the sums of
-/// [`RoutingData::add_weighted_hessians`] in the same order (with `w_s = f_c`), written through
-/// column slices. Batched routings go batch by batch ([`add_weighted_hessians_batched`]: each
-/// block overwritten, so `out` must hold zeros there).
-pub(crate) fn add_weighted_hessians(
-    routing: &Routing,
-    hessians: SegmentHessians<'_>,
-    weights: Weights<'_>,
-    out: &mut ColMajor,
-) -> Result<(), StiffnessError> {
-    if let Some(batches) = hessians.batches() {
-        return add_weighted_hessians_batched(routing, batches, weights, out);
-    }
-    for (s, (seg, h)) in hessians.iter().enumerate() {
-        let (lo, n) = (seg.dofs.start, seg.dofs.len());
-        if n == 0 {
-            continue;
-        }
-        let Some(w) = weights.get(seg.cable, s) else {
-            return Err(weights.mismatch(routing));
-        };
-        if h.len() != n * n || lo + n > out.rows() || lo + n > out.cols() {
-            return Err(StiffnessError::DimensionMismatch {
-                what: "segment Hessian",
-                expected: n * n,
-                got: s,
-            });
-        }
-        if let [h00, h10, h01, h11] = *h {
-            // A segment across one universal joint (every routed segment): fixed bounds.
-            let col = &mut out.col_mut(lo)[lo..lo + 2];
-            col[0] += w * h00;
-            col[1] += w * h10;
-            let col = &mut out.col_mut(lo + 1)[lo..lo + 2];
-            col[0] += w * h01;
-            col[1] += w * h11;
-            continue;
-        }
-        for (k, h) in h.chunks_exact(n).enumerate() {
-            let col = &mut out.col_mut(lo + k)[lo..lo + n];
-            for (v, h) in col.iter_mut().zip(h) {
-                *v += w * h;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// `Σ_c f_c H_c` batch by batch (routed models), each batch's diagonal block overwritten (the
-/// batches cross disjoint DOFs, and no segment reaches outside its batch's block, so the
-/// entries outside the blocks are never written and stay zero): a batch's segments cross the
-/// same DOFs, so each entry of its block is one running sum from zero over the batch's
-/// segments, kept in a register, in routing order (the sums of [`add_weighted_hessians`] on a
-/// zeroed matrix, in the same order), reading the blocks and the cables in storage order.
-fn add_weighted_hessians_batched<'a>(
-    routing: &Routing,
-    batches: impl Iterator<Item = HessianBatch<'a>>,
-    weights: Weights<'_>,
-    out: &mut ColMajor,
-) -> Result<(), StiffnessError> {
-    for batch in batches {
-        let (lo, n) = (batch.dofs.start, batch.dofs.len());
-        if batch.blocks.len() != batch.cables.len() * n * n
-            || batch.segments.len() != batch.cables.len()
-            || lo + n > out.rows()
-            || lo + n > out.cols()
-        {
-            return Err(StiffnessError::DimensionMismatch {
-                what: "segment Hessian batch",
-                expected: batch.cables.len() * n * n,
-                got: batch.blocks.len(),
-            });
-        }
-        let entries = batch.cables.iter().zip(batch.segments);
-        if n == 2 {
-            let mut acc = [0.0; 4];
-            for ((&c, &r), h) in entries.zip(batch.blocks.chunks_exact(4)) {
-                let w = weights.get(c, r).ok_or_else(|| weights.mismatch(routing))?;
-                for t in 0..4 {
-                    acc[t] += w * h[t];
-                }
-            }
-            out.col_mut(lo)[lo..lo + 2].copy_from_slice(&acc[..2]);
-            out.col_mut(lo + 1)[lo..lo + 2].copy_from_slice(&acc[2..]);
-            continue;
-        }
-        for k in lo..lo + n {
-            out.col_mut(k)[lo..lo + n].fill(0.0);
-        }
-        for ((&c, &r), h) in entries.zip(batch.blocks.chunks_exact(n * n)) {
-            let w = weights.get(c, r).ok_or_else(|| weights.mismatch(routing))?;
-            for (k, h) in h.chunks_exact(n).enumerate() {
-                let col = &mut out.col_mut(lo + k)[lo..lo + n];
-                for (v, h) in col.iter_mut().zip(h) {
-                    *v += w * h;
-                }
             }
         }
     }

@@ -41,6 +41,7 @@ mod end_data;
 mod error;
 mod friction;
 mod friction_arm;
+mod hessian_sums;
 mod holes;
 mod inherent;
 mod joint;
