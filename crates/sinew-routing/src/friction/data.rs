@@ -136,6 +136,9 @@ pub struct FrictionData {
     pub(crate) weights: Vec<f64>,
     /// `J̃_c`, m × dof, column-major.
     pub(crate) effective_jacobian: Vec<f64>,
+    /// Scratch: the unit normal `u_k × u_{k+1} / |u_k × u_{k+1}|` of each hole's bend, per
+    /// entry (not meaningful at a kinked hole).
+    pub(crate) normals: Vec<[f64; 3]>,
     /// Scratch: each joint's moment `a_i × p_i` (base frame), one per DOF.
     pub(crate) moments: Vec<[f64; 3]>,
 }
@@ -159,6 +162,7 @@ impl FrictionData {
             wrap_gradients: vec![0.0; model.wrap_len],
             weights: vec![0.0; n],
             effective_jacobian: vec![0.0; m * model.dof],
+            normals: vec![[0.0; 3]; n],
             moments: vec![[0.0; 3]; model.dof],
         }
     }

@@ -84,7 +84,9 @@ pub fn compute_friction_geometry(
             data.lengths[first + s] = segment_lengths[r];
             data.directions[first + s] = u;
         }
-        // Wrap angles at every hole but the anchor.
+        // Wrap angles at every hole but the anchor, and each bend's unit normal: one short loop
+        // of independent square roots, `atan2`s and divisions (they overlap in the processor),
+        // then the gradients.
         for k in 0..entries.len() - 1 {
             let e = first + k;
             let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
@@ -92,13 +94,18 @@ pub fn compute_friction_geometry(
             let sine = dot(&w, &w).sqrt();
             data.wrap[e] = sine.atan2(dot(&u_in, &u_out));
             data.kinked[e] = sine < WRAP_KINK;
+            data.normals[e] = scale(&w, 1.0 / sine);
+        }
+        for k in 0..entries.len() - 1 {
+            let e = first + k;
+            let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
             let slot = &entries[k].wrap;
             let gradient = &mut data.wrap_gradients[slot.offset..slot.offset + slot.dofs.len()];
             if data.kinked[e] {
                 gradient.fill(0.0);
                 continue;
             }
-            let n = scale(&w, 1.0 / sine);
+            let n = data.normals[e];
             let (g_in, g_out) = (cross(&n, &u_in), cross(&n, &u_out));
             let at = data.positions[e];
             let (next, b_next) = (data.positions[e + 1], entries[k + 1].hole_body);
