@@ -98,15 +98,13 @@ pub fn slip_stiffness(
     // order); the μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal, then mirrored.
     let weight = |cable: &CableRows<'_>, s: usize| cable.weights.map_or(1.0, |w| w[s]);
     add_segment_hessians((model, routing, geometry), friction, actuator, weight, out)?;
-    for (c, _) in actuator.iter().enumerate() {
-        if mu[c] == 0.0 {
-            let cable = &routing.cables()[c];
-            let k = cable.stiffness;
-            for j in cable.dofs.clone() {
-                let kj = k * j_c[(c, j)];
-                for i in cable.dofs.start..=j {
-                    *out.inherent.at_mut(i, j) += kj * j_c[(c, i)];
-                }
+    // The μ = 0 cables' k_c J_cᵀ J_c on and above the diagonal (eq. 13–14), mirrored below.
+    for (c, cable) in routing.cables().iter().enumerate().filter(|&(c, _)| mu[c] == 0.0) {
+        let k = cable.stiffness;
+        for j in cable.dofs.clone() {
+            let kj = k * j_c[(c, j)];
+            for i in cable.dofs.start..=j {
+                *out.inherent.at_mut(i, j) += kj * j_c[(c, i)];
             }
         }
     }
