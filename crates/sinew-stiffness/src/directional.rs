@@ -43,7 +43,7 @@ use sinew_routing::{FrictionData, FrictionModel, Routing};
 use crate::error::StiffnessError;
 use crate::friction::History;
 use crate::holes::{BandEdge, Hole, HoleEvent, dot, holes};
-use crate::stick_limit::{EDGE_TOLERANCE, RATE_TOLERANCE};
+use crate::holes::{EDGE_TOLERANCE, RATE_TOLERANCE};
 
 /// The response along one signed direction.
 #[derive(Debug, Clone, PartialEq)]

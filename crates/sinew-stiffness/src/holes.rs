@@ -17,6 +17,16 @@ use sinew_routing::{DofRow, FrictionData, FrictionModel, Routing};
 use crate::error::StiffnessError;
 use crate::friction::{History, axial_rigidity};
 
+/// A hole is on an edge of its band when `g ≤ EDGE_TOLERANCE · (T_k + T_{k+1})`: a pull or
+/// release distribution puts every hole on an edge up to the rounding of `e^{±μθ}` products
+/// (1e-16 relative), and no band a real arm has is this narrow.
+pub const EDGE_TOLERANCE: f64 = 1e-12;
+
+/// An edge's rate `ġ` is taken as 0 (the increment neither approaches nor leaves the edge)
+/// when `|ġ| ≤ RATE_TOLERANCE ·` the sum of its terms' magnitudes: cancellation, as at a hole
+/// inside one body, whose segments keep their lengths and angle.
+pub const RATE_TOLERANCE: f64 = 1e-10;
+
 /// Which edge of a hole's capstan band `T_k e^{−μθ} ≤ T_{k+1} ≤ T_k e^{+μθ}`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BandEdge {
@@ -52,6 +62,9 @@ pub struct HoleEvent {
     /// is taken as 0).
     pub kinked: bool,
 }
+
+/// Each edge of a hole: `(edge, (a, b, d), g, whether the hole is on it)` ([`Hole::edges`]).
+pub(crate) type Edges = [(BandEdge, (f64, f64, f64), f64, bool); 2];
 
 /// One hole's band at the pose.
 #[derive(Debug, Clone, Copy)]
@@ -92,6 +105,15 @@ impl Hole {
         }
     }
 
+    /// Each edge, lower first: `(edge, (a, b, d), g, whether the hole is on it)`, on it when
+    /// `g ≤` [`EDGE_TOLERANCE`] `· (T_k + T_{k+1})`.
+    pub fn edges(&self) -> Edges {
+        [BandEdge::Lower, BandEdge::Upper].map(|edge| {
+            let g = self.room(edge);
+            (edge, self.rate_coefficients(edge), g, g <= EDGE_TOLERANCE * self.scale())
+        })
+    }
+
     /// `T_k + T_{k+1}`, the scale of `g` and `ġ`'s tolerances.
     pub fn scale(&self) -> f64 {
         self.tensions[0] + self.tensions[1]
@@ -127,16 +149,22 @@ pub(crate) fn holes(
         };
         let tension = |s: usize| weights.map_or(t_0, |w| t_0 * w[s]);
         let (angles, kinked) = (friction.wrap_angles(model, c)?, friction.kinked(model, c)?);
+        // Each segment's spring once (it is after one hole and before the next), and one
+        // exponential per hole (`e^{+μθ} = 1/e^{−μθ}`, to a unit of rounding).
+        let mut spring = lengths.first().map_or(0.0, |l| ea / l);
         for (k, (&theta, &kinked)) in angles.iter().zip(kinked).enumerate() {
+            let next = ea / lengths[k + 1];
+            let lower = (-mu * theta).exp();
             out.push(Hole {
                 cable: c,
                 hole: k,
                 kinked,
                 tensions: [tension(k), tension(k + 1)],
-                springs: [ea / lengths[k], ea / lengths[k + 1]],
-                ratios: [(-mu * theta).exp(), (mu * theta).exp()],
+                springs: [spring, next],
+                ratios: [lower, 1.0 / lower],
                 mu,
             });
+            spring = next;
         }
     }
     Ok(out)

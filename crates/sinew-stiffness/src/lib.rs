@@ -42,6 +42,7 @@ mod error;
 mod friction;
 mod friction_arm;
 mod hessian_sums;
+mod hole_bounds;
 mod holes;
 mod inherent;
 mod joint;
@@ -61,11 +62,9 @@ pub use end_data::{END_RANK_TOLERANCE, EndStiffnessData, compliance_inverse, has
 pub use error::StiffnessError;
 pub use friction::{FrictionRegime, FrictionStiffnessData, History};
 pub use friction_arm::FrictionArmData;
-pub use holes::{BandEdge, HoleEvent};
+pub use holes::{BandEdge, EDGE_TOLERANCE, HoleEvent, RATE_TOLERANCE};
 pub use joint::{joint_block, joint_stiffness, stiffness_slope};
 pub use outcome::{Outcome, OutcomeNote};
 pub use slip::slip_stiffness;
 pub use stick::stick_stiffness;
-pub use stick_limit::{
-    EDGE_TOLERANCE, RATE_TOLERANCE, StickLoadLimit, base_directions, stick_load_limits,
-};
+pub use stick_limit::{StickLoadLimit, base_directions, stick_load_limits};

@@ -19,11 +19,21 @@
 //! per unit `α`, with `δθ_k = ∇θ_k · δQ`: the band moves with the pose, and that counts. An
 //! edge the increment approaches (`ġ < 0`) is reached at `α = g / (−ġ)`; the stick load limit
 //! along `u` is the least such `α` over every hole and edge, to first order in `α`. A hole
-//! already on an edge (`g ≤` [`EDGE_TOLERANCE`] `· (T_k + T_{k+1})`, as after a
+//! already on an edge (`g ≤` [`EDGE_TOLERANCE`](crate::EDGE_TOLERANCE) `· (T_k + T_{k+1})`, as after a
 //! [`History::Pull`] or [`History::Release`]) that the increment pushes outward slides at once:
 //! the limit is 0 and every such hole is named ([`StickLoadLimit::at_once`]). From
 //! [`History::Equal`] every band of a bent cable has room on both sides and the limit is
 //! positive in every direction.
+//!
+//! # Cost
+//! The answer needs the least `α` over every hole, but not every hole's `α`: each hole's rates
+//! are bounded once by `|ġ| ≤ ρ max_{i∈S}|δQ_i|` (`S` the DOFs of its rows,
+//! `ρ = |a| E A/ℓ_{k+1} ‖J_{k+1}‖₁ + |b| E A/ℓ_k ‖J_k‖₁ + |d| ‖∇θ_k‖₁`), and along a direction
+//! a hole whose bound `g/(ρ max|δQ_i|)` exceeds an `α` already found is skipped. After
+//! [`History::Equal`] an extra direction then costs less than one solve of `K_stick + K_W`
+//! (docs/performance.md, `scripts/stick-limit-instructions`). After a pull or release every
+//! hole is on an edge and each direction names the holes it pushes over theirs, about half of
+//! them: there a direction costs a pass over the holes, shared with its mirror `−u`.
 //!
 //! At a kinked hole (`θ ≈ 0`, [`sinew_routing::FrictionData::kinked`]) the band has no width and
 //! `θ`'s gradient is taken as 0: the one-sided growth of `θ` there (`δθ ≥ 0` whichever way the
@@ -38,17 +48,8 @@ use sinew_routing::{FrictionData, FrictionModel, Routing};
 use crate::end::stability_margin;
 use crate::error::StiffnessError;
 use crate::friction::History;
-use crate::holes::{BandEdge, Hole, HoleEvent, dot, holes};
-
-/// A hole is on an edge of its band when `g ≤ EDGE_TOLERANCE · (T_k + T_{k+1})`: a pull or
-/// release distribution puts every hole on an edge up to the rounding of `e^{±μθ}` products
-/// (1e-16 relative), and no band a real arm has is this narrow.
-pub const EDGE_TOLERANCE: f64 = 1e-12;
-
-/// An edge's rate `ġ` is taken as 0 (the increment neither approaches nor leaves the edge)
-/// when `|ġ| ≤ RATE_TOLERANCE ·` the sum of its terms' magnitudes: cancellation, as at a hole
-/// inside one body, whose segments keep their lengths and angle.
-pub const RATE_TOLERANCE: f64 = 1e-10;
+use crate::hole_bounds::{Best, HoleBounds};
+use crate::holes::{Edges, Hole, HoleEvent, RATE_TOLERANCE, dot, holes};
 
 /// The stick load limit along one direction.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,8 +84,12 @@ pub fn base_directions() -> [Vector6<f64>; 12] {
 /// ([`crate::stick_stiffness`], dof × dof), `k_w` the load's (`K_W`), `j_x` the end-effector
 /// Jacobian (6 × dof), `friction` the friction geometry at the pose (with the history's
 /// capstan weights for [`History::Pull`] and [`History::Release`]). One factorisation of
-/// `K_stick + K_W`, one solve with a right-hand side per direction, and one pass over the
-/// holes for every direction (module docs for the math).
+/// `K_stick + K_W`, one solve with a right-hand side per direction (none for a direction that
+/// is the negation of an earlier one: its joint motion and rates are that one's, negated), and
+/// one walk over the holes for every direction. Holes on an edge of their band are computed
+/// along every direction; the others are bounded once, and along each direction only those
+/// that may be reached first are computed, with the same answer to the bit as computing them
+/// all (module docs for the math).
 ///
 /// # Errors
 /// [`StiffnessError::StickWithoutFriction`] for a cable with μ = 0;
@@ -126,91 +131,146 @@ pub fn stick_load_limits(
         return Err(StiffnessError::Unstable { min_eigenvalue: stability_margin(k_stick, k_w)? });
     }
     let lu = k.partial_piv_lu();
-    // Every direction's joint motion in one solve with as many right-hand sides, then one pass
-    // over the holes for them all.
-    let rhs = Mat::from_fn(n, directions.len(), |i, j| {
-        (0..6).map(|r| j_x[(r, i)] * directions[j][r]).sum::<f64>()
+    // A direction that is the negation of an earlier one (as `±e_i` are) is that one's mirror:
+    // its joint motion and every rate are the negated ones, exactly (rounding is symmetric), so
+    // neither is computed twice. The others' joint motions in one solve with as many
+    // right-hand sides, then one walk over the holes for them all.
+    let pairs = mirror_pairs(directions);
+    let rhs = Mat::from_fn(n, pairs.len(), |i, p| {
+        (0..6).map(|r| j_x[(r, i)] * directions[pairs[p].0][r]).sum::<f64>()
     });
     let dq = lu.solve(rhs);
-    along(model, friction, &holes, directions, dq.as_ref())
+    along(model, friction, &holes, directions, &pairs, dq.as_ref())
 }
 
-/// The limit along each of `directions`, given their joint motions per unit `α` (the columns
-/// of `dq`, n × directions): one pass over the holes for every direction, each hole's
-/// coefficients read once and each segment's stretch `J_s δQ` computed once per direction (it
-/// is the stretch after one hole and before the next).
+/// The directions to compute, each with its mirror if one follows it: `(j, Some(k))` when
+/// `directions[k] = −directions[j]`, `k > j` the first such not yet taken. Every direction is in
+/// one pair, once.
+fn mirror_pairs(directions: &[Vector6<f64>]) -> Vec<(usize, Option<usize>)> {
+    let mut taken = vec![false; directions.len()];
+    let mut pairs = Vec::with_capacity(directions.len());
+    for (j, u) in directions.iter().enumerate() {
+        if taken[j] {
+            continue;
+        }
+        let mirror = (j + 1..directions.len()).find(|&k| !taken[k] && directions[k] == -u);
+        if let Some(k) = mirror {
+            taken[k] = true;
+        }
+        pairs.push((j, mirror));
+    }
+    pairs
+}
+
+/// The limit along each of `directions`, given the joint motions per unit `α` of each pair
+/// of [`mirror_pairs`] (the columns of `dq`, n × pairs).
+///
+/// Every hole is checked, but most without computing their rates ([`HoleBounds`]: a bound
+/// `g/(ρ max_{i∈S}|δQ_i|)` on when each is reached); the answer is the full pass's to the bit:
+/// the same least `α`, and among equal ones the first hole and edge in its order (cable by
+/// cable, hole by hole, lower edge first). Holes on an edge are computed along every direction,
+/// in that order, since every one pushed over its edge is named.
 fn along(
     model: &FrictionModel,
     friction: &FrictionData,
     holes: &[Hole],
     directions: &[Vector6<f64>],
+    pairs: &[(usize, Option<usize>)],
     dq: MatRef<'_, f64>,
 ) -> Result<Vec<StickLoadLimit>, StiffnessError> {
     let n = dq.nrows();
     let mut out: Vec<StickLoadLimit> = directions
         .iter()
-        .enumerate()
-        .map(|(j, u)| StickLoadLimit {
+        .map(|u| StickLoadLimit {
             direction: *u,
             magnitude: f64::INFINITY,
             first: None,
             at_once: Vec::new(),
-            joint_motion: (0..n).map(|i| dq[(i, j)]).collect(),
+            joint_motion: Vec::new(),
         })
         .collect();
-    // Each direction's stretch of the segment before the current hole.
-    let mut stretch = vec![0.0; directions.len()];
-    // The holes come cable by cable, hole by hole ([`holes`]): walk each cable's segments
-    // (read once per cable) in step, segment `k` before hole `k` and `k + 1` after it.
-    let mut pending = holes.iter();
-    for c in 0..model.cable_count() {
-        let mut segments = friction.segments(model, c)?.enumerate();
-        let Some((_, mut before)) = segments.next() else {
-            continue;
-        };
-        // The free length does not stretch (the actuator holds its end).
-        stretch.fill(0.0);
-        for (s, after) in segments {
-            let h = match pending.next() {
-                Some(h) if (h.cable, h.hole + 1) == (c, s) => h,
-                _ => {
-                    let expected = holes.len();
-                    let what = "holes (cable by cable, in order)";
-                    return Err(StiffnessError::DimensionMismatch { what, expected, got: s });
-                }
-            };
-            let edges = [BandEdge::Lower, BandEdge::Upper].map(|edge| {
-                let g = h.room(edge);
-                (edge, h.rate_coefficients(edge), g, g <= EDGE_TOLERANCE * h.scale())
-            });
-            for (limit, stretch) in out.iter_mut().zip(stretch.iter_mut()) {
-                let dq = &limit.joint_motion;
-                // δT per unit α of the two segments: spring times stretch.
-                let dt_k = h.springs[0] * *stretch;
-                *stretch = dot(&after.jacobian, dq);
-                let dt_next = h.springs[1] * *stretch;
-                let dtheta = dot(&before.wrap_gradient, dq);
-                for &(edge, (a, b, d), g, at_edge) in &edges {
-                    let dg = a * dt_next + b * dt_k + d * dtheta;
-                    let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
-                    if dg >= -RATE_TOLERANCE * terms {
-                        continue;
-                    }
-                    if at_edge {
-                        limit.at_once.push(h.event(edge));
-                    } else if g / -dg < limit.magnitude {
-                        limit.magnitude = g / -dg;
-                        limit.first = Some(h.event(edge));
-                    }
-                }
-            }
-            before = after;
+    for (p, &(j, mirror)) in pairs.iter().enumerate() {
+        out[j].joint_motion = (0..n).map(|i| dq[(i, p)]).collect();
+        if let Some(k) = mirror {
+            out[k].joint_motion = (0..n).map(|i| -dq[(i, p)]).collect();
         }
     }
-    for limit in &mut out {
-        if let Some(&event) = limit.at_once.first() {
-            (limit.magnitude, limit.first) = (0.0, Some(event));
+    // Per direction: the least `α` so far, with its hole's place in the full pass's order and
+    // its event.
+    let mut best: Vec<Best> = vec![(f64::INFINITY, usize::MAX, None); directions.len()];
+    // The holes on an edge (every hole, along one pair of directions) hole by hole, every
+    // direction for each, as the full pass: a segment's stretch `J_s δQ` computed once when it
+    // is after one such hole and before the next, and a mirror's rates negated.
+    let mut stretch = vec![0.0; pairs.len()];
+    let exhaustive = pairs.len() == 1;
+    let bounds = HoleBounds::walk(model, friction, holes, n, exhaustive, |visit| {
+        let (i, h, edges, [after, before, wrap], carried) = visit;
+        for (&(j, mirror), stretch) in pairs.iter().zip(&mut stretch) {
+            let dq = &out[j].joint_motion;
+            let first = if carried { *stretch } else { dot(before, dq) };
+            *stretch = dot(after, dq);
+            let rates = [h.springs[1] * *stretch, h.springs[0] * first, dot(wrap, dq)];
+            check(h, i, edges, rates, &mut best[j], &mut out[j].at_once);
+            if let Some(k) = mirror {
+                let rates = rates.map(|r| -r);
+                check(h, i, edges, rates, &mut best[k], &mut out[k].at_once);
+            }
         }
+    })?;
+    // The other holes, along each direction on which none of those slides at once.
+    let mut scratch = Vec::new();
+    let cables = match bounds.is_empty() {
+        true => Vec::new(),
+        false => (0..model.cable_count())
+            .map(|c| friction.cable(model, c))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
+    for (limit, best) in out.iter_mut().zip(&mut best) {
+        if limit.at_once.is_empty() {
+            let (dq, at_once) = (&limit.joint_motion, &mut limit.at_once);
+            bounds.search(dq, &mut scratch, best, |i, best| {
+                let (h, rows) = (&holes[i], &cables[holes[i].cable]);
+                let rates = [
+                    h.springs[1] * dot(&rows.jacobian(h.hole + 1), dq),
+                    h.springs[0] * dot(&rows.jacobian(h.hole), dq),
+                    dot(&rows.wrap_gradient(h.hole), dq),
+                ];
+                check(h, i, &h.edges(), rates, best, at_once);
+            });
+        }
+        (limit.magnitude, limit.first) = match limit.at_once.first() {
+            Some(&event) => (0.0, Some(event)),
+            None => (best.0, best.2),
+        };
     }
     Ok(out)
+}
+
+/// Hole `h` (place `i` in the full pass's order) under the rates `[δT_{k+1}, δT_k, δθ_k]` per
+/// unit `α` (spring times stretch for the two segments; the free length's row is empty, and
+/// the band's motion): each edge the increment approaches is pushed to `at_once` if the hole is
+/// on it, else `best` is replaced if it is reached sooner (or as soon, by an earlier hole).
+fn check(
+    h: &Hole,
+    i: usize,
+    edges: &Edges,
+    [dt_next, dt_k, dtheta]: [f64; 3],
+    best: &mut Best,
+    at_once: &mut Vec<HoleEvent>,
+) {
+    for &(edge, (a, b, d), g, on_edge) in edges {
+        let dg = a * dt_next + b * dt_k + d * dtheta;
+        let terms = (a * dt_next).abs() + (b * dt_k).abs() + (d * dtheta).abs();
+        if dg >= -RATE_TOLERANCE * terms {
+            continue;
+        }
+        if on_edge {
+            at_once.push(h.event(edge));
+        } else {
+            let alpha = g / -dg;
+            if alpha < best.0 || (alpha == best.0 && i < best.1) {
+                *best = (alpha, i, Some(h.event(edge)));
+            }
+        }
+    }
 }
