@@ -74,12 +74,13 @@ impl HoleBounds {
         let mut placed = vec![(usize::MAX, 0.0); holes.len()];
         let mut pending = holes.iter().zip(placed.iter_mut()).enumerate();
         for c in 0..model.cable_count() {
-            let mut segments = friction.segments(model, c)?.enumerate();
-            let Some((_, mut before)) = segments.next() else {
-                continue;
-            };
+            // Rows by index (a whole segment's rows, moved from one hole to the next, cost a
+            // stalled copy per hole).
+            let cable = friction.cable(model, c)?;
+            let mut before = cable.jacobian(0);
             let mut carried = false;
-            for (s, after) in segments {
+            for s in 1..cable.len() {
+                let (after, wrap) = (cable.jacobian(s), cable.wrap_gradient(s - 1));
                 let (i, h, place) = match pending.next() {
                     Some((i, (h, place))) if (h.cable, h.hole + 1) == (c, s) => (i, h, place),
                     _ => {
@@ -89,14 +90,12 @@ impl HoleBounds {
                 };
                 let edges = h.edges();
                 if exhaustive || edges.iter().any(|e| e.3) {
-                    let rows = [&after.jacobian, &before.jacobian, &before.wrap_gradient];
-                    visit((i, h, &edges, rows, carried));
+                    visit((i, h, &edges, [&after, &before, &wrap], carried));
                     carried = true;
                     before = after;
                     continue;
                 }
-                let [after_l1, before_l1, wrap_l1] =
-                    [&after.jacobian, &before.jacobian, &before.wrap_gradient].map(l1);
+                let [after_l1, before_l1, wrap_l1] = [&after, &before, &wrap].map(l1);
                 let mut beta = f64::INFINITY;
                 for &(_, (a, b, d), g, _) in &edges {
                     let rho = a.abs() * h.springs[1] * after_l1
@@ -104,7 +103,7 @@ impl HoleBounds {
                         + d.abs() * wrap_l1;
                     beta = beta.min(g / rho);
                 }
-                let rows = [&after.jacobian, &before.jacobian, &before.wrap_gradient];
+                let rows = [&after, &before, &wrap];
                 let (mut start, mut end) = (usize::MAX, 0);
                 for row in rows.iter().filter(|r| !r.dofs.is_empty()) {
                     (start, end) = (start.min(row.dofs.start), end.max(row.dofs.end));

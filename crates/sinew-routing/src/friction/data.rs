@@ -89,12 +89,14 @@ impl<'a> CableRows<'a> {
     }
 
     /// `J_s` of friction segment `s` ([`FrictionData::segment_jacobian`]; empty for `s ≥ H`).
+    #[inline]
     pub fn jacobian(&self, s: usize) -> DofRow<'a> {
         self.entries.get(s).map_or(EMPTY, |e| row(self.jacobians, &e.jacobian))
     }
 
     /// `∂θ_k/∂Q` of hole `k` ([`FrictionData::wrap_gradient`]; empty for the anchor and for
     /// `k ≥ H`).
+    #[inline]
     pub fn wrap_gradient(&self, k: usize) -> DofRow<'a> {
         self.entries.get(k).map_or(EMPTY, |e| row(self.wrap_gradients, &e.wrap))
     }
@@ -374,6 +376,7 @@ impl FrictionData {
     }
 }
 
+#[inline]
 fn row<'a>(store: &'a [f64], slot: &Slot) -> DofRow<'a> {
     DofRow { dofs: slot.dofs.clone(), values: &store[slot.offset..slot.offset + slot.dofs.len()] }
 }
