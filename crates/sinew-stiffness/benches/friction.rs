@@ -199,8 +199,9 @@ fn bench_friction(c: &mut Criterion) {
             })
         });
         // The stick load limit after `equal` (every band has room): one factorisation of
-        // K_stick + K_W, then per direction one solve and one pass over the holes. One
-        // direction, then the twelve base directions and the load's; and one solve alone.
+        // K_stick + K_W, one solve per direction (none for a mirror `−u`) and one walk over
+        // the holes, then per direction the holes that may be reached first. One direction,
+        // then the twelve base directions and the load's; and one solve alone.
         stick_stiffness(model, routing, g, f, History::Equal, t, out).unwrap();
         let (k_stick, k_w, j_x) = (out.stiffness().unwrap(), data.k_w().to_owned(), data.j_x());
         let mut directions = base_directions().to_vec();
