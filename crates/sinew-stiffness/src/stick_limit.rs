@@ -19,10 +19,10 @@
 //! per unit `α`, with `δθ_k = ∇θ_k · δQ`: the band moves with the pose, and that counts. An
 //! edge the increment approaches (`ġ < 0`) is reached at `α = g / (−ġ)`; the stick load limit
 //! along `u` is the least such `α` over every hole and edge, to first order in `α`. A hole
-//! already on an edge (`g ≤` [`EDGE_TOLERANCE`](crate::EDGE_TOLERANCE) `· (T_k + T_{k+1})`, as after a
-//! [`History::Pull`] or [`History::Release`]) that the increment pushes outward slides at once:
-//! the limit is 0 and every such hole is named ([`StickLoadLimit::at_once`]). From
-//! [`History::Equal`] every band of a bent cable has room on both sides and the limit is
+//! already on an edge (`g ≤` [`EDGE_TOLERANCE`](crate::EDGE_TOLERANCE) `· (T_k + T_{k+1})`,
+//! as after a [`History::Pull`] or [`History::Release`]) that the increment pushes outward
+//! slides at once: the limit is 0 and every such hole is named ([`StickLoadLimit::at_once`]).
+//! From [`History::Equal`] every band of a bent cable has room on both sides and the limit is
 //! positive in every direction.
 //!
 //! # Cost
