@@ -21,7 +21,7 @@
 
 use std::ops::Range;
 
-use sinew_routing::{DofRow, FrictionData, FrictionModel};
+use sinew_routing::{CableRows, DofRow};
 
 use crate::error::StiffnessError;
 use crate::holes::{Edges, Hole, HoleEvent};
@@ -55,13 +55,12 @@ const SKIP_MARGIN: f64 = 1e-9;
 pub(crate) type Visit<'r, 'a> = (usize, &'r Hole, &'r Edges, [&'r DofRow<'a>; 3], bool);
 
 impl HoleBounds {
-    /// One walk over every cable's segments in order (segment `k` before hole `k`, `k + 1`
-    /// after it) and `holes` with them (cable by cable, hole by hole, as `holes.rs` gives them,
-    /// over `n` DOFs): a hole on an edge of its band, or every hole when `exhaustive`, is
-    /// handed to `visit`, in that order; every other is bounded and grouped.
+    /// One walk over every cable's segments (`cables`, in order; segment `k` before hole `k`,
+    /// `k + 1` after it) and `holes` with them (cable by cable, hole by hole, as `holes.rs`
+    /// gives them, over `n` DOFs): a hole on an edge of its band, or every hole when
+    /// `exhaustive`, is handed to `visit`, in that order; every other is bounded and grouped.
     pub(crate) fn walk(
-        model: &FrictionModel,
-        friction: &FrictionData,
+        cables: &[CableRows<'_>],
         holes: &[Hole],
         n: usize,
         exhaustive: bool,
@@ -73,10 +72,9 @@ impl HoleBounds {
         // Per hole: the DOF its group starts at (`usize::MAX`: in no group), and its β.
         let mut placed = vec![(usize::MAX, 0.0); holes.len()];
         let mut pending = holes.iter().zip(placed.iter_mut()).enumerate();
-        for c in 0..model.cable_count() {
+        for (c, cable) in cables.iter().enumerate() {
             // Rows by index (a whole segment's rows, moved from one hole to the next, cost a
             // stalled copy per hole).
-            let cable = friction.cable(model, c)?;
             let mut before = cable.jacobian(0);
             let mut carried = false;
             for s in 1..cable.len() {
@@ -144,11 +142,6 @@ impl HoleBounds {
             }
         }
         Ok(HoleBounds { groups, members })
-    }
-
-    /// Whether no hole was bounded (each was handed over, or has no rate).
-    pub(crate) fn is_empty(&self) -> bool {
-        self.groups.is_empty()
     }
 
     /// Along the joint motion `dq`, every grouped hole that may be reached no later than

@@ -203,7 +203,11 @@ fn along(
     // is after one such hole and before the next, and a mirror's rates negated.
     let mut stretch = vec![0.0; pairs.len()];
     let exhaustive = pairs.len() == 1;
-    let bounds = HoleBounds::walk(model, friction, holes, n, exhaustive, |visit| {
+    // Each cable's rows, the workspace checked once: for the walk, then the holes skipped in it.
+    let cables = (0..model.cable_count())
+        .map(|c| friction.cable(model, c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let bounds = HoleBounds::walk(&cables, holes, n, exhaustive, |visit| {
         let (i, h, edges, [after, before, wrap], carried) = visit;
         for (&(j, mirror), stretch) in pairs.iter().zip(&mut stretch) {
             let dq = &out[j].joint_motion;
@@ -219,12 +223,6 @@ fn along(
     })?;
     // The other holes, along each direction on which none of those slides at once.
     let mut scratch = Vec::new();
-    let cables = match bounds.is_empty() {
-        true => Vec::new(),
-        false => (0..model.cable_count())
-            .map(|c| friction.cable(model, c))
-            .collect::<Result<Vec<_>, _>>()?,
-    };
     for (limit, best) in out.iter_mut().zip(&mut best) {
         if limit.at_once.is_empty() {
             let (dq, at_once) = (&limit.joint_motion, &mut limit.at_once);
