@@ -11,7 +11,7 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 
 use crate::planner::{Objective, PlanSettings, Planner, PlannerData, Requirements, StickPlanData};
 use crate::robot::Robot;
-use crate::routing::{FrictionModel, Routing, Slip};
+use crate::routing::{FrictionModel, Routing, Slip, compute_wrap_gradients};
 use crate::statics::TensionChoice;
 use crate::stiffness::{
     ArmStiffness, ArmStiffnessData, EndOutcome, FrictionArmData, FrictionRegime, History,
@@ -188,6 +188,7 @@ pub fn e6(robot: &Robot, routings: [(&str, &Routing); 2]) -> Result<E6, crate::E
                     let k_w = data.k_w().to_owned();
                     let j_x = data.j_x().to_owned();
                     let increment = (k_q.as_ref(), k_w.as_ref(), j_x.as_ref());
+                    compute_wrap_gradients(&model, &mut out.friction)?;
                     let (f, t) = (&out.friction, &out.actuator);
                     let [plus, minus] =
                         directional_response(&model, routing, f, history, t, increment, &u)?;

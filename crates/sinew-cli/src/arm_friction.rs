@@ -5,7 +5,7 @@
 
 use nalgebra::Vector6;
 use serde::Serialize;
-use sinew::routing::{FrictionModel, Routing, Slip};
+use sinew::routing::{FrictionModel, Routing, Slip, compute_wrap_gradients};
 use sinew::stiffness::{
     ArmStiffness, ArmStiffnessData, BandEdge, DirectionalResponse, EndOutcome, FrictionArmData,
     FrictionRegime, History, HoleEvent, StickLoadLimit, base_directions, directional_response,
@@ -265,6 +265,7 @@ pub fn run(
     match (history, u) {
         (Some(history), Some(u)) if stable => {
             let increment = (k_q.as_ref(), k_w.as_ref(), j_x.as_ref());
+            compute_wrap_gradients(&model, &mut out.friction).map_err(library_error)?;
             let (f, t) = (&out.friction, &out.actuator);
             let [plus, minus] = directional_response(&model, routing, f, history, t, increment, &u)
                 .map_err(library_error)?;

@@ -8,7 +8,7 @@ use std::process::{Command, Output};
 
 use nalgebra::Vector6;
 use serde_json::Value;
-use sinew::routing::{FrictionModel, Slip};
+use sinew::routing::{FrictionModel, Slip, compute_wrap_gradients};
 use sinew::statics::{TensionChoice, TensionPolicy};
 use sinew::stiffness::{
     ArmStiffness, ArmStiffnessData, FrictionArmData, FrictionRegime, History, base_directions,
@@ -109,6 +109,7 @@ fn the_stick_and_slip_documents_are_the_librarys_numbers() {
         let j_x = data.j_x().to_owned();
         let increment = (k_q, k_w.as_ref(), j_x.as_ref());
         let u = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+        compute_wrap_gradients(&model, &mut out.friction).unwrap();
         let (f, t) = (&out.friction, &out.actuator);
         let [plus, minus] =
             directional_response(&model, &routing, f, history, t, increment, &u).unwrap();

@@ -20,7 +20,7 @@
 use nalgebra::{Matrix3x2, Vector2};
 use sinew_routing::{
     FrictionData, FrictionModel, Routing, RoutingData, RoutingError, compute_capstan_weights,
-    compute_friction_geometry,
+    compute_friction_angles, compute_friction_geometry,
 };
 use sinew_statics::{TensionLimits, actuator_interval, cable_actuator_limits, tension_interval};
 use sinew_stiffness::{
@@ -85,7 +85,11 @@ impl ProbeFriction {
         tensions: &mut [f64],
     ) -> Result<JointStiffnessRange, IndicatorError> {
         let (model, data) = (&self.model, &mut self.data);
-        compute_friction_geometry(model, routing, cables, data)?;
+        // The stick regime reads no wrap gradient (`compute_friction_angles` alone).
+        match self.regime {
+            FrictionRegime::Slip(_) => compute_friction_geometry(model, routing, cables, data)?,
+            FrictionRegime::Stick(_) => compute_friction_angles(model, routing, cables, data)?,
+        }
         let [f_min, f_max] = routing.tension_limits();
         let limits = TensionLimits { f_min, f_max };
         let slip = match self.regime {

@@ -7,7 +7,7 @@
 use nalgebra::Vector6;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use sinew::routing::{FrictionModel, Routing, Slip};
+use sinew::routing::{FrictionModel, Routing, Slip, compute_wrap_gradients};
 use sinew::statics::TensionChoice;
 use sinew::stiffness::{
     ArmStiffness, ArmStiffnessData, BandEdge, DirectionalResponse, EndOutcome, FrictionArmData,
@@ -277,6 +277,7 @@ pub fn evaluate_friction(
         let mut answers = None;
         if let (Some(history), Some(u), true) = (history, u, stable) {
             let increment = (k_q.as_ref(), k_w.as_ref(), j_x.as_ref());
+            compute_wrap_gradients(model, &mut out.friction).map_err(library)?;
             let (f, t) = (&out.friction, &out.actuator);
             let both = directional_response(model, routing, f, history, t, increment, &u)
                 .map_err(library)?;

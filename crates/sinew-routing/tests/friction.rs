@@ -15,7 +15,7 @@ use sinew_robot::{Robot, RobotData};
 use sinew_routing::{
     CableFriction, ExplicitCable, FrictionData, FrictionModel, HoleSpec, Order, PatternModel,
     Routing, RoutingData, Slip, compute_cable_geometry, compute_capstan_weights,
-    compute_friction_geometry,
+    compute_friction_angles, compute_friction_geometry, compute_wrap_gradients,
 };
 use sinew_testkit::cdhrm5;
 use sinew_testkit::config::{random_q, random_qs, rng};
@@ -445,13 +445,73 @@ fn the_cable_view_reads_the_rows_of_the_accessors() {
                 assert_eq!(view.jacobian(s), data.segment_jacobian(&model, c, s).unwrap());
                 assert_eq!(view.routing_segment(s), model.routing_segment(c, s), "{case}");
                 if s + 1 < h {
-                    assert_eq!(view.wrap_gradient(s), data.wrap_gradient(&model, c, s).unwrap());
+                    let row = data.wrap_gradient(&model, c, s).unwrap();
+                    assert_eq!(view.wrap_gradient(s), Some(row), "{case}");
                 }
             }
             // Past the end: empty rows, no segment.
-            assert!(view.jacobian(h).values.is_empty() && view.wrap_gradient(h).values.is_empty());
+            assert!(view.jacobian(h).values.is_empty());
+            assert!(view.wrap_gradient(h).unwrap().values.is_empty());
             assert_eq!(view.routing_segment(h), None);
         }
         assert!(data.cable(&model, model.cable_count()).is_err(), "{case}: no such cable");
+    }
+}
+
+#[test]
+fn the_angles_then_the_wrap_gradients_are_the_whole_geometry_bit_for_bit() {
+    for (case, robot, routing, _) in cases() {
+        let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+        let qs = random_qs(&robot, 2, 17);
+        let (mut rdata, mut routing_data) = (RobotData::new(&robot), RoutingData::new(&routing));
+        let mut at = |q: &[f64], routing_data: &mut RoutingData| {
+            compute_cable_geometry(&routing, &robot, &mut rdata, routing_data, q, Order::Hessians)
+                .unwrap();
+        };
+        let mut split = FrictionData::new(&model);
+        assert!(compute_wrap_gradients(&model, &mut split).is_err(), "{case}: before the angles");
+        // The whole geometry at one pose, then the angles alone at another: the first pose's
+        // gradients are no longer offered.
+        at(&qs[0], &mut routing_data);
+        compute_friction_geometry(&model, &routing, &routing_data, &mut split).unwrap();
+        assert!(split.check_wrap_gradients().is_ok(), "{case}");
+        at(&qs[1], &mut routing_data);
+        let mut whole = FrictionData::new(&model);
+        compute_friction_geometry(&model, &routing, &routing_data, &mut whole).unwrap();
+        compute_friction_angles(&model, &routing, &routing_data, &mut split).unwrap();
+        assert!(split.check_wrap_gradients().is_err(), "{case}: stale gradients offered");
+        assert!(split.wrap_gradient(&model, 0, 0).is_err(), "{case}");
+        assert_eq!(split.cable(&model, 0).unwrap().wrap_gradient(0), None, "{case}");
+        assert!(split.segments(&model, 0).unwrap().all(|s| s.wrap_gradient.is_none()), "{case}");
+        compute_capstan_weights(&model, &mut split, Slip::Pull).unwrap();
+        compute_capstan_weights(&model, &mut whole, Slip::Pull).unwrap();
+        assert!(split.weight_gradient(&model, 0, 1).is_err(), "{case}");
+        for c in 0..model.cable_count() {
+            let (a, b) = (&split, &whole);
+            assert_eq!(bits(a.lengths(&model, c).unwrap()), bits(b.lengths(&model, c).unwrap()));
+            assert_eq!(bits(a.weights(&model, c).unwrap()), bits(b.weights(&model, c).unwrap()));
+            let angles = |d: &FrictionData| bits(d.wrap_angles(&model, c).unwrap());
+            assert_eq!(angles(a), angles(b), "{case}: cable {c}");
+            assert_eq!(a.kinked(&model, c).unwrap(), b.kinked(&model, c).unwrap(), "{case}");
+            let directions = |d: &FrictionData| d.directions(&model, c).unwrap().concat();
+            assert_eq!(bits(&directions(a)), bits(&directions(b)), "{case}: cable {c}");
+            for s in 0..model.segment_count(c).unwrap() {
+                let row = |d: &FrictionData| bits(d.segment_jacobian(&model, c, s).unwrap().values);
+                assert_eq!(row(a), row(b), "{case}: cable {c}, segment {s}");
+            }
+        }
+        // Then the gradients, from what the angles left: the whole geometry's, to the bit.
+        compute_wrap_gradients(&model, &mut split).unwrap();
+        let wrap_rows = whole.wrap_gradient(&model, 0, 0).unwrap().values.len();
+        assert!(wrap_rows > 0, "{case}: a wrap row to compare");
+        for c in 0..model.cable_count() {
+            for k in 0..model.segment_count(c).unwrap() - 1 {
+                let row = |d: &FrictionData| bits(d.wrap_gradient(&model, c, k).unwrap().values);
+                assert_eq!(row(&split), row(&whole), "{case}: cable {c}, hole {k}");
+                let weight =
+                    |d: &FrictionData| bits(&d.weight_gradient(&model, c, k + 1).unwrap().values);
+                assert_eq!(weight(&split), weight(&whole), "{case}: cable {c}, hole {k}");
+            }
+        }
     }
 }

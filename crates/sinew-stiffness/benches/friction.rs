@@ -9,7 +9,10 @@
 //!   slip stiffness;
 //! - `slip + stick`: the same, then the stick stiffness after a pull history;
 //! - `pipeline`: the whole frictionless `Q → K_x` ([`ArmStiffness::evaluate`], as in
-//!   `benches/stiffness.rs`; its `K_q` is accumulated over the layout's blocks);
+//!   `benches/stiffness.rs`; its `K_q` is accumulated over the layout's blocks), alone. (Until
+//!   session 21 it also ran the cable geometry with Hessians once more, so its times, and the
+//!   ratios to it in docs/performance.md's sessions 10–20, were those of more than the
+//!   pipeline: the ratios were understated.)
 //! - `pipeline + slip`, `pipeline + slip + stick`: the pipeline, then what a caller adds today
 //!   for friction with the public API: the cable geometry with Hessians once more (the
 //!   pipeline's own is not exposed), the friction geometry, weights, slip (and stick) stiffness;
@@ -60,8 +63,8 @@ struct Case {
 }
 
 /// Which parts of a step run: the frictionless pipeline (`pipeline`, run by the caller), the
-/// cable geometry with Hessians (always) and `K_q` (`k_q`), the friction geometry, weights and
-/// slip stiffness (`slip`), and the stick stiffness after them (`stick`).
+/// cable geometry with Hessians (with any of the others) and `K_q` (`k_q`), the friction
+/// geometry, weights and slip stiffness (`slip`), and the stick stiffness after them (`stick`).
 #[derive(Clone, Copy)]
 struct Parts {
     pipeline: bool,
@@ -91,6 +94,9 @@ impl Case {
 
     fn step(&mut self, parts: Parts) {
         let (routing, model, t) = (&self.routing, &self.model, &self.tensions[..]);
+        if !(parts.k_q || parts.slip || parts.stick) {
+            return; // `pipeline` alone: `ArmStiffness::evaluate` and nothing else.
+        }
         compute_cable_geometry(
             routing,
             &self.robot,

@@ -16,7 +16,7 @@
 //! affine in the actuator tensions for a given regime (and history).
 
 use faer::MatRef;
-use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData, Slip};
+use sinew_routing::{CableRows, DofRow, FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
@@ -245,6 +245,19 @@ pub(crate) fn check_weights(friction: &FrictionData, slip: Slip) -> Result<(), S
         return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed: friction.slip() });
     }
     Ok(())
+}
+
+/// `∂θ_k/∂Q` of hole `k` from `cable`'s rows; an error when the geometry was computed
+/// without the wrap gradients (`sinew_routing::compute_friction_angles` alone).
+#[inline]
+pub(crate) fn wrap_row<'a>(cable: &CableRows<'a>, k: usize) -> Result<DofRow<'a>, StiffnessError> {
+    match cable.wrap_gradient(k) {
+        Some(row) => Ok(row),
+        None => Err(StiffnessError::Routing(sinew_routing::RoutingError::FrictionNotComputed {
+            what: "wrap gradients",
+            call: "compute_wrap_gradients (or compute_friction_geometry)",
+        })),
+    }
 }
 
 /// `E A` of the routing's cables, N.

@@ -19,7 +19,8 @@
 
 use nalgebra::Vector6;
 use sinew_routing::{
-    FrictionData, FrictionModel, compute_capstan_weights, compute_friction_geometry,
+    FrictionData, FrictionModel, compute_capstan_weights, compute_friction_angles,
+    compute_friction_geometry,
 };
 use sinew_statics::{
     TensionChoice, TensionPolicy, actuator_limits, check_balance, dead_band,
@@ -92,6 +93,11 @@ impl ArmStiffness {
     /// then `C_x` and `K_x`. The arm's own workspace `data` holds the pose (and, after `equal`,
     /// the frictionless tension stage). Unstable and rank-deficient are outcomes.
     ///
+    /// In the stick regime `out.friction` holds the friction geometry without the wrap
+    /// gradients, which nothing in it reads (`sinew_routing::compute_friction_angles`); call
+    /// `sinew_routing::compute_wrap_gradients(model, &mut out.friction)` before
+    /// [`crate::directional_response`] or [`crate::stick_load_limits`] on it.
+    ///
     /// # Errors
     /// Those of the pose stage, the statics, [`crate::stick_stiffness`] (μ = 0 in
     /// the stick regime) and [`crate::slip_stiffness`]; numerical failures of the end stage.
@@ -107,7 +113,17 @@ impl ArmStiffness {
         out.outcome = None;
         self.set_pose(data, q, f0)?;
         let routing = self.routing();
-        compute_friction_geometry(model, routing, &data.cables, &mut out.friction)?;
+        // The stick regime's tensions and stiffness read no wrap gradient: the directional
+        // response and the stick load limit, which do, are asked for after
+        // `sinew_routing::compute_wrap_gradients`.
+        match regime {
+            FrictionRegime::Slip(_) => {
+                compute_friction_geometry(model, routing, &data.cables, &mut out.friction)?
+            }
+            FrictionRegime::Stick(_) => {
+                compute_friction_angles(model, routing, &data.cables, &mut out.friction)?
+            }
+        }
         let slip = match regime {
             FrictionRegime::Slip(slip) => Some(slip),
             FrictionRegime::Stick(history) => history.slip(),

@@ -204,6 +204,7 @@ fn along(
     let mut stretch = vec![0.0; pairs.len()];
     let exhaustive = pairs.len() == 1;
     // Each cable's rows, the workspace checked once: for the walk, then the holes skipped in it.
+    friction.check_wrap_gradients()?;
     let cables = (0..model.cable_count())
         .map(|c| friction.cable(model, c))
         .collect::<Result<Vec<_>, _>>()?;
@@ -231,7 +232,7 @@ fn along(
                 let rates = [
                     h.springs[1] * dot(&rows.jacobian(h.hole + 1), dq),
                     h.springs[0] * dot(&rows.jacobian(h.hole), dq),
-                    dot(&rows.wrap_gradient(h.hole), dq),
+                    rows.wrap_gradient(h.hole).map_or(0.0, |g| dot(&g, dq)), // (Checked above.)
                 ];
                 check(h, i, &h.edges(), rates, best, at_once);
             });

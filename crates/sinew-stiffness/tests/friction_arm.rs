@@ -9,11 +9,12 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use nalgebra::Vector6;
-use sinew_routing::{FrictionModel, Slip};
+use sinew_routing::{FrictionModel, RoutingError, Slip, compute_wrap_gradients};
 use sinew_statics::{StaticsError, TensionChoice, TensionPolicy};
 use sinew_stiffness::{
     ArmStiffness, ArmStiffnessData, BandEdge, EndOutcome, FrictionArmData, FrictionRegime, History,
-    HoleEvent, StiffnessError, directional_response, sliding_response,
+    HoleEvent, StiffnessError, base_directions, directional_response, sliding_response,
+    stick_load_limits,
 };
 use sinew_testkit::cdhrm5;
 
@@ -170,6 +171,20 @@ fn an_unstable_or_singular_sliding_set_is_refused() {
     let (k_w, j_x) = (data.k_w().to_owned(), data.j_x().to_owned());
     let n = k_q.nrows();
     let u = Vector6::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+    // The stick evaluation computes no wrap gradient; what needs them says so until
+    // `compute_wrap_gradients` adds them.
+    let increment = (k_q.as_ref(), k_w.as_ref(), j_x.as_ref());
+    let (f, t) = (&out.friction, &out.actuator);
+    let e = directional_response(&model, &routing, f, History::Pull, t, increment, &u).unwrap_err();
+    let missing = |e: &StiffnessError| {
+        matches!(e, StiffnessError::Routing(RoutingError::FrictionNotComputed { what, .. })
+            if *what == "wrap gradients")
+    };
+    assert!(missing(&e), "{e}");
+    let base = base_directions();
+    let e = stick_load_limits(&model, &routing, f, History::Pull, t, increment, &base).unwrap_err();
+    assert!(missing(&e), "{e}");
+    compute_wrap_gradients(&model, &mut out.friction).unwrap();
     let (f, t) = (&out.friction, &out.actuator);
     let stick = Mat::from_fn(n, n, |i, j| 0.5 * (k_q[(i, j)] + k_q[(j, i)]) + k_w[(i, j)]);
     let least = stick.self_adjoint_eigenvalues(faer::Side::Lower).unwrap()[0];

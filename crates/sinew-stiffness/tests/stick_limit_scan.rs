@@ -57,7 +57,7 @@ fn full_pass(
             let hi = 1.0 / lo;
             let dt_k = springs[0] * dot(&rows.jacobian(k), dq);
             let dt_next = springs[1] * dot(&rows.jacobian(k + 1), dq);
-            let dtheta = dot(&rows.wrap_gradient(k), dq);
+            let dtheta = dot(&rows.wrap_gradient(k).expect("wrap gradients"), dq);
             let turn = mu * t_k;
             for (edge, g, (a, b, d)) in [
                 (BandEdge::Lower, t_next - t_k * lo, (1.0, -lo, lo * turn)),

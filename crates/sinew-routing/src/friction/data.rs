@@ -53,8 +53,9 @@ pub struct SegmentRows<'a> {
     /// `J_s` over the segment's DOFs ([`FrictionData::segment_jacobian`]).
     pub jacobian: DofRow<'a>,
     /// `∂θ_s/∂Q` of hole `s`, where the segment ends ([`FrictionData::wrap_gradient`]; empty
-    /// for the anchor, which has no wrap angle).
-    pub wrap_gradient: DofRow<'a>,
+    /// for the anchor, which has no wrap angle; `None` when the wrap gradients were not
+    /// computed, [`crate::compute_friction_angles`] alone).
+    pub wrap_gradient: Option<DofRow<'a>>,
     /// The routing segment it is (`None` for segment 0, the free length): its Hessian block is
     /// `H_s` over [`SegmentRows::jacobian`]'s DOFs ([`crate::SegmentHessians::get`]).
     pub routing_segment: Option<usize>,
@@ -74,7 +75,7 @@ pub struct CableRows<'a> {
     pub wrap: &'a [f64],
     entries: &'a [Entry],
     jacobians: &'a [f64],
-    wrap_gradients: &'a [f64],
+    wrap_gradients: Option<&'a [f64]>,
 }
 
 impl<'a> CableRows<'a> {
@@ -95,10 +96,12 @@ impl<'a> CableRows<'a> {
     }
 
     /// `∂θ_k/∂Q` of hole `k` ([`FrictionData::wrap_gradient`]; empty for the anchor and for
-    /// `k ≥ H`).
+    /// `k ≥ H`); `None` when the wrap gradients were not computed
+    /// ([`crate::compute_friction_angles`] alone, [`FrictionData::check_wrap_gradients`]).
     #[inline]
-    pub fn wrap_gradient(&self, k: usize) -> DofRow<'a> {
-        self.entries.get(k).map_or(EMPTY, |e| row(self.wrap_gradients, &e.wrap))
+    pub fn wrap_gradient(&self, k: usize) -> Option<DofRow<'a>> {
+        let store = self.wrap_gradients?;
+        Some(self.entries.get(k).map_or(EMPTY, |e| row(store, &e.wrap)))
     }
 
     /// The routing segment friction segment `s` is (`None` for the free length, `s = 0`, and
@@ -117,6 +120,8 @@ const EMPTY: DofRow<'static> = DofRow { dofs: 0..0, values: &[] };
 #[derive(Debug, Clone)]
 pub struct FrictionData {
     pub(crate) geometry: bool,
+    /// Whether `wrap_gradients` hold `∂θ_k/∂Q` at the geometry's configuration.
+    pub(crate) gradients: bool,
     pub(crate) slip: Option<Slip>,
     pub(crate) cables: usize,
     pub(crate) dof: usize,
@@ -138,10 +143,9 @@ pub struct FrictionData {
     pub(crate) weights: Vec<f64>,
     /// `J̃_c`, m × dof, column-major.
     pub(crate) effective_jacobian: Vec<f64>,
-    /// Scratch: the unit normal `u_k × u_{k+1} / |u_k × u_{k+1}|` of each hole's bend, per
-    /// entry (not meaningful at a kinked hole).
-    pub(crate) normals: Vec<[f64; 3]>,
-    /// Scratch: each joint's moment `a_i × p_i` (base frame), one per DOF.
+    /// Each joint's axis `a_i` (base frame) at the geometry's configuration, one per DOF.
+    pub(crate) axes: Vec<[f64; 3]>,
+    /// Each joint's moment `a_i × p_i` (base frame) at the geometry's configuration, one per DOF.
     pub(crate) moments: Vec<[f64; 3]>,
 }
 
@@ -152,6 +156,7 @@ impl FrictionData {
         let m = model.cables.len();
         FrictionData {
             geometry: false,
+            gradients: false,
             slip: None,
             cables: m,
             dof: model.dof,
@@ -164,7 +169,7 @@ impl FrictionData {
             wrap_gradients: vec![0.0; model.wrap_len],
             weights: vec![0.0; n],
             effective_jacobian: vec![0.0; m * model.dof],
-            normals: vec![[0.0; 3]; n],
+            axes: vec![[0.0; 3]; model.dof],
             moments: vec![[0.0; 3]; model.dof],
         }
     }
@@ -235,6 +240,7 @@ impl FrictionData {
     /// As [`FrictionData::lengths`]; [`RoutingError::DimensionMismatch`] for `k ≥ H − 1`.
     pub fn wrap_gradient(&self, model: &FrictionModel, c: usize, k: usize) -> Result<DofRow<'_>> {
         let range = self.geometry_of(model, c)?;
+        self.check_wrap_gradients()?;
         if k + 1 >= range.len() {
             let expected = range.len() - 1;
             return Err(RoutingError::DimensionMismatch { what: "hole index", expected, got: k });
@@ -267,6 +273,7 @@ impl FrictionData {
         s: usize,
     ) -> Result<WeightGradient> {
         let range = self.weights_of(model, c)?;
+        self.check_wrap_gradients()?;
         let entry = model.entry(c, s)?;
         let dofs = entry.weight.clone();
         let mut values = vec![0.0; dofs.len()];
@@ -295,7 +302,7 @@ impl FrictionData {
             wrap: &self.wrap[range.clone()],
             entries: &model.entries[range],
             jacobians: &self.jacobians,
-            wrap_gradients: &self.wrap_gradients,
+            wrap_gradients: self.gradients.then_some(&self.wrap_gradients[..]),
         })
     }
 
@@ -310,13 +317,13 @@ impl FrictionData {
         c: usize,
     ) -> Result<impl ExactSizeIterator<Item = SegmentRows<'a>> + 'a> {
         let range = self.geometry_of(model, c)?;
-        let weighted = self.slip.is_some();
+        let (weighted, gradients) = (self.slip.is_some(), self.gradients);
         let entries = model.entries.get(range.clone()).unwrap_or(&[]);
         Ok(entries.iter().zip(range).map(move |(entry, e)| SegmentRows {
             length: self.lengths[e],
             weight: weighted.then(|| self.weights[e]),
             jacobian: row(&self.jacobians, &entry.jacobian),
-            wrap_gradient: row(&self.wrap_gradients, &entry.wrap),
+            wrap_gradient: gradients.then(|| row(&self.wrap_gradients, &entry.wrap)),
             routing_segment: entry.routing,
         }))
     }
@@ -331,6 +338,22 @@ impl FrictionData {
             return Err(WEIGHTS_MISSING);
         }
         Ok(MatRef::from_column_major_slice(&self.effective_jacobian, self.cables, self.dof))
+    }
+
+    /// Whether the wrap gradients `∂θ_k/∂Q` are computed at the geometry's configuration
+    /// ([`crate::compute_wrap_gradients`], part of [`crate::compute_friction_geometry`]).
+    ///
+    /// # Errors
+    /// [`RoutingError::FrictionNotComputed`] when they are not (the geometry computed by
+    /// [`crate::compute_friction_angles`] alone, or not at all).
+    pub fn check_wrap_gradients(&self) -> Result<()> {
+        if self.geometry && self.gradients {
+            return Ok(());
+        }
+        Err(RoutingError::FrictionNotComputed {
+            what: "wrap gradients",
+            call: "compute_wrap_gradients (or compute_friction_geometry)",
+        })
     }
 
     /// Cable `c`'s entries, once the geometry is computed.

@@ -19,6 +19,9 @@ pub const WRAP_KINK: f64 = 1e-12;
 /// hole's wrap angle `θ_k` and its gradient `∂θ_k/∂Q`, into `data`. Any regime's weights must
 /// be computed again after it ([`crate::compute_capstan_weights`]).
 ///
+/// It is [`compute_friction_angles`] then [`compute_wrap_gradients`]: a caller that needs no
+/// `∂θ_k/∂Q` (the stick regime's stiffness, spec §9) calls the first alone.
+///
 /// Allocates nothing. On error `data` holds nothing valid.
 ///
 /// # Math
@@ -38,21 +41,45 @@ pub fn compute_friction_geometry(
     routing_data: &RoutingData,
     data: &mut FrictionData,
 ) -> Result<()> {
+    compute_friction_angles(model, routing, routing_data, data)?;
+    compute_wrap_gradients(model, data)
+}
+
+/// The friction geometry without the wrap gradients: every friction segment's length `ℓ_s`,
+/// direction `u_s` and `J_s`, every hole's wrap angle `θ_k` (module docs of
+/// `crate::friction`), at the configuration `routing_data` was last evaluated at. What the
+/// stick regime's statics and stiffness read; [`compute_wrap_gradients`] adds `∂θ_k/∂Q` (the
+/// slip regimes, the directional response and the stick load limit need them). Until then
+/// [`FrictionData::wrap_gradient`] and [`FrictionData::weight_gradient`] answer
+/// [`RoutingError::FrictionNotComputed`] and [`crate::CableRows::wrap_gradient`] `None`.
+///
+/// Allocates nothing. On error `data` holds nothing valid.
+///
+/// # Errors
+/// As [`compute_friction_geometry`].
+pub fn compute_friction_angles(
+    model: &FrictionModel,
+    routing: &Routing,
+    routing_data: &RoutingData,
+    data: &mut FrictionData,
+) -> Result<()> {
     model.check(routing)?;
     routing_data.check(routing)?;
     data.check(model)?;
     routing_data.need(crate::Order::Lengths, "routing geometry (for the friction geometry)")?;
     data.geometry = false;
+    data.gradients = false;
     data.slip = None;
     let kinematics = routing_data.kinematics();
     let segment_lengths = routing_data.segment_lengths()?;
     // With the routing's Jacobian at hand (Order::Jacobian and above), a cable whose segments
     // cross distinct DOFs reads each J_s from J_c.
     let j_c = routing_data.jacobian().ok();
-    // Each joint's moment `m_i = a_i × p_i`: `(a_i × (x − p_i))·g = a_i·(x × g) − g·m_i`.
-    for (i, m) in data.moments.iter_mut().enumerate() {
+    // Each joint's axis `a_i` and moment `m_i = a_i × p_i`, kept for the wrap gradients:
+    // `(a_i × (x − p_i))·g = a_i·(x × g) − g·m_i`.
+    for (i, (a, m)) in data.axes.iter_mut().zip(&mut data.moments).enumerate() {
         let (axis, origin) = joint(kinematics, i, model.dof)?;
-        *m = cross(axis, origin);
+        (*a, *m) = (*axis, cross(axis, origin));
     }
     for (c, range) in model.cables.iter().enumerate() {
         let entries = &model.entries[range.clone()];
@@ -84,18 +111,47 @@ pub fn compute_friction_geometry(
             data.lengths[first + s] = segment_lengths[r];
             data.directions[first + s] = u;
         }
-        // Wrap angles at every hole but the anchor, and each bend's unit normal: one short loop
-        // of independent square roots, `atan2`s and divisions (they overlap in the processor),
-        // then the gradients.
+        // Wrap angles at every hole but the anchor: one short loop of independent square roots
+        // and `atan2`s (they overlap in the processor). `libm`'s `atan2` (musl's, < 1 ulp): half
+        // the cost of glibc's.
         for k in 0..entries.len() - 1 {
             let e = first + k;
             let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
-            let w = cross(&u_in, &u_out);
-            let sine = dot(&w, &w).sqrt();
+            let sine = bend(&u_in, &u_out).1;
             data.wrap[e] = sine.atan2(dot(&u_in, &u_out));
             data.kinked[e] = sine < WRAP_KINK;
-            data.normals[e] = scale(&w, 1.0 / sine);
         }
+        data.wrap[first + entries.len() - 1] = 0.0;
+        data.kinked[first + entries.len() - 1] = false;
+    }
+    data.geometry = true;
+    Ok(())
+}
+
+/// The wrap gradients `∂θ_k/∂Q` of every hole (module docs of `crate::friction`) at the
+/// configuration of the last [`compute_friction_angles`], from what that call left in `data`
+/// (the holes, directions, bends and joints at that configuration), so the two always agree.
+/// Does nothing when they are already computed; [`compute_friction_geometry`] is both calls.
+///
+/// Allocates nothing.
+///
+/// # Errors
+/// [`RoutingError::WorkspaceMismatch`] for a workspace of another model;
+/// [`RoutingError::FrictionNotComputed`] before [`compute_friction_angles`].
+pub fn compute_wrap_gradients(model: &FrictionModel, data: &mut FrictionData) -> Result<()> {
+    data.check(model)?;
+    if !data.geometry {
+        return Err(RoutingError::FrictionNotComputed {
+            what: "friction geometry (for the wrap gradients)",
+            call: "compute_friction_angles",
+        });
+    }
+    if data.gradients {
+        return Ok(());
+    }
+    for range in &model.cables {
+        let entries = &model.entries[range.clone()];
+        let first = range.start;
         for k in 0..entries.len() - 1 {
             let e = first + k;
             let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
@@ -105,7 +161,8 @@ pub fn compute_friction_geometry(
                 gradient.fill(0.0);
                 continue;
             }
-            let n = data.normals[e];
+            let (w, sine) = bend(&u_in, &u_out);
+            let n = scale(&w, 1.0 / sine);
             let (g_in, g_out) = (cross(&n, &u_in), cross(&n, &u_out));
             let at = data.positions[e];
             let (next, b_next) = (data.positions[e + 1], entries[k + 1].hole_body);
@@ -126,7 +183,7 @@ pub fn compute_friction_geometry(
             let (out_at, out_next) = (cross(&at, &g_out), cross(&next, &g_out));
             let out_scale = 1.0 / data.lengths[e + 1];
             for (out, i) in gradient.iter_mut().zip(slot.dofs.clone()) {
-                let (axis, _) = joint(kinematics, i, model.dof)?;
+                let axis = data.axes.get(i).ok_or_else(|| mismatch(model.dof))?;
                 let m = data.moments.get(i).ok_or_else(|| mismatch(model.dof))?;
                 let (gm_in, gm_out) = (dot(&g_in, m), dot(&g_out, m));
                 let into = match &incoming {
@@ -150,11 +207,17 @@ pub fn compute_friction_geometry(
                 *out = outgoing - into;
             }
         }
-        data.wrap[first + entries.len() - 1] = 0.0;
-        data.kinked[first + entries.len() - 1] = false;
     }
-    data.geometry = true;
+    data.gradients = true;
     Ok(())
+}
+
+/// A hole's bend from its two directions: `u_in × u_out` and its norm, the sine of the wrap
+/// angle.
+#[inline]
+fn bend(u_in: &[f64; 3], u_out: &[f64; 3]) -> ([f64; 3], f64) {
+    let w = cross(u_in, u_out);
+    (w, dot(&w, &w).sqrt())
 }
 
 /// What turns the incoming direction at a hole: the entry direction (hole 0: `u_0 × g_in`,

@@ -59,9 +59,12 @@
 //! Model/data split: [`FrictionModel`] (immutable, built once from a [`crate::Routing`]: the
 //! layout of every row and each cable's μ and entry direction) and [`FrictionData`] (the
 //! workspace, sized once). [`compute_friction_geometry`] reads the kinematics a
-//! [`crate::RoutingData`] holds from its last evaluation; [`compute_capstan_weights`] then
-//! gives one regime's weights (`∂w_s/∂Q` is not stored: [`FrictionData::weight_gradient`]
-//! computes it on demand). Neither allocates. Layout: `model.rs`, workspace and its
+//! [`crate::RoutingData`] holds from its last evaluation; it is [`compute_friction_angles`]
+//! (everything but `∂θ_k/∂Q`: what the stick regime reads) then [`compute_wrap_gradients`]
+//! (the slip regimes, the directional response and the stick load limit read them), so a stick
+//! evaluation skips the gradients. [`compute_capstan_weights`] then gives one regime's weights
+//! (`∂w_s/∂Q` is not stored: [`FrictionData::weight_gradient`] computes it on demand). None
+//! allocates. Layout: `model.rs`, workspace and its
 //! accessors: `data.rs`, the geometry: `geometry.rs`, the weights: `weights.rs`.
 
 mod data;
@@ -70,6 +73,8 @@ mod model;
 mod weights;
 
 pub use data::{CableRows, DofRow, FrictionData, SegmentRows, WeightGradient};
-pub use geometry::{WRAP_KINK, compute_friction_geometry};
+pub use geometry::{
+    WRAP_KINK, compute_friction_angles, compute_friction_geometry, compute_wrap_gradients,
+};
 pub use model::{FrictionModel, Slip};
 pub use weights::compute_capstan_weights;
