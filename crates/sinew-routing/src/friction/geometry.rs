@@ -118,7 +118,7 @@ pub fn compute_friction_angles(
             let e = first + k;
             let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
             let sine = bend(&u_in, &u_out).1;
-            data.wrap[e] = sine.atan2(dot(&u_in, &u_out));
+            data.wrap[e] = libm::atan2(sine, dot(&u_in, &u_out));
             data.kinked[e] = sine < WRAP_KINK;
         }
         data.wrap[first + entries.len() - 1] = 0.0;
