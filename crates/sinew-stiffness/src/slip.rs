@@ -81,7 +81,9 @@ use crate::friction::{
 ///
 /// # Errors
 /// [`StiffnessError::WrongCapstanWeights`] when `friction` holds the other regime's weights or
-/// none; [`StiffnessError::DimensionMismatch`]; routing errors.
+/// none; [`StiffnessError::DimensionMismatch`]; routing errors (among them
+/// `FrictionNotComputed` for a geometry without its wrap gradients,
+/// `sinew_routing::compute_friction_angles` alone).
 pub fn slip_stiffness(
     model: &FrictionModel,
     routing: &Routing,

@@ -95,7 +95,10 @@ pub fn base_directions() -> [Vector6<f64>; 12] {
 /// [`StiffnessError::StickWithoutFriction`] for a cable with μ = 0;
 /// [`StiffnessError::WrongCapstanWeights`]; [`StiffnessError::InvalidWrenchDirection`] for a
 /// zero or non-finite direction; [`StiffnessError::Unstable`] when `K_stick + K_W` is not
-/// positive definite; [`StiffnessError::DimensionMismatch`]; routing errors.
+/// positive definite; [`StiffnessError::DimensionMismatch`]; routing errors (among them
+/// `FrictionNotComputed` for a geometry without its wrap gradients, as
+/// [`crate::ArmStiffness::evaluate_with_friction`] leaves it in the stick regime:
+/// `sinew_routing::compute_wrap_gradients` adds them).
 pub fn stick_load_limits(
     model: &FrictionModel,
     routing: &Routing,

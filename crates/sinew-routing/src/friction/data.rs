@@ -237,7 +237,9 @@ impl FrictionData {
     /// the highest body of holes `k − 1, k, k + 1`; 0 at a kinked hole.
     ///
     /// # Errors
-    /// As [`FrictionData::lengths`]; [`RoutingError::DimensionMismatch`] for `k ≥ H − 1`.
+    /// As [`FrictionData::lengths`]; [`RoutingError::DimensionMismatch`] for `k ≥ H − 1`;
+    /// [`RoutingError::FrictionNotComputed`] when the geometry was computed without the wrap
+    /// gradients ([`FrictionData::check_wrap_gradients`]).
     pub fn wrap_gradient(&self, model: &FrictionModel, c: usize, k: usize) -> Result<DofRow<'_>> {
         let range = self.geometry_of(model, c)?;
         self.check_wrap_gradients()?;
@@ -265,7 +267,9 @@ impl FrictionData {
     /// `slip.rs` in `sinew-stiffness`), checks and reports do.
     ///
     /// # Errors
-    /// As [`FrictionData::weights`]; [`RoutingError::DimensionMismatch`] for `s ≥ H`.
+    /// As [`FrictionData::weights`]; [`RoutingError::DimensionMismatch`] for `s ≥ H`;
+    /// [`RoutingError::FrictionNotComputed`] without the wrap gradients
+    /// ([`FrictionData::check_wrap_gradients`]).
     pub fn weight_gradient(
         &self,
         model: &FrictionModel,

@@ -64,8 +64,8 @@
 //! (the slip regimes, the directional response and the stick load limit read them), so a stick
 //! evaluation skips the gradients. [`compute_capstan_weights`] then gives one regime's weights
 //! (`∂w_s/∂Q` is not stored: [`FrictionData::weight_gradient`] computes it on demand). None
-//! allocates. Layout: `model.rs`, workspace and its
-//! accessors: `data.rs`, the geometry: `geometry.rs`, the weights: `weights.rs`.
+//! allocates. Layout: `model.rs`, workspace and its accessors: `data.rs`, the geometry:
+//! `geometry.rs`, the weights: `weights.rs`.
 
 mod data;
 mod geometry;
