@@ -60,7 +60,7 @@ mod vec3;
 pub use error::{JointProblem, Result, RoutingError};
 pub use friction::{
     CableRows, DofRow, FrictionData, FrictionModel, SegmentRows, Slip, WRAP_KINK, WeightGradient,
-    compute_capstan_weights, compute_friction_angles, compute_friction_geometry,
+    capstan_factor, compute_capstan_weights, compute_friction_angles, compute_friction_geometry,
     compute_wrap_gradients,
 };
 pub use geometry::{

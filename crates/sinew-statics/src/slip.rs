@@ -32,7 +32,7 @@
 
 use std::ops::Range;
 
-use sinew_routing::{FrictionData, FrictionModel};
+use sinew_routing::{FrictionData, FrictionModel, capstan_factor};
 
 use faer::Mat;
 use nalgebra::Vector3;
@@ -132,7 +132,7 @@ pub fn dead_band(
     for (c, (&t_a, out)) in anchor.iter().zip(out.iter_mut()).enumerate() {
         // Π_k e^{σμθ_k} = e^{σμ Σ_k θ_k}: two exponentials per cable, not two per hole.
         let wrap: f64 = data.wrap_angles(model, c)?.iter().sum();
-        let (pull, release) = ((-mu[c] * wrap).exp(), (mu[c] * wrap).exp());
+        let (pull, release) = (capstan_factor(-mu[c] * wrap), capstan_factor(mu[c] * wrap));
         *out = [t_a / release, t_a / pull];
     }
     Ok(())

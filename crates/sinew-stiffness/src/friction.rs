@@ -16,7 +16,7 @@
 //! affine in the actuator tensions for a given regime (and history).
 
 use faer::MatRef;
-use sinew_routing::{CableRows, DofRow, FrictionData, FrictionModel, Routing, RoutingData, Slip};
+use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
 use crate::colmajor::{ColMajor, mirror_upper};
 use crate::error::StiffnessError;
@@ -202,13 +202,18 @@ impl FrictionStiffnessData {
         for ((k, c), i) in self.stiffness.as_mut_slice().iter_mut().zip(c).zip(i) {
             *k = c + i;
         }
+        // Each pair (r, j), (j, r) once: the symmetric part's two equal entries, and the skew
+        // part's two equal squares.
         let mut skew = 0.0;
         for j in 0..n {
-            for r in 0..n {
+            for r in 0..j {
                 let (a, b) = (self.stiffness.at(r, j), self.stiffness.at(j, r));
-                *self.symmetric.at_mut(r, j) = 0.5 * (a + b);
-                skew += (0.5 * (a - b)).powi(2);
+                let mean = 0.5 * (a + b);
+                *self.symmetric.at_mut(r, j) = mean;
+                *self.symmetric.at_mut(j, r) = mean;
+                skew += 2.0 * (0.5 * (a - b)).powi(2);
             }
+            *self.symmetric.at_mut(j, j) = self.stiffness.at(j, j);
         }
         self.skew_norm = skew.sqrt();
         self.regime = Some(regime);
@@ -245,19 +250,6 @@ pub(crate) fn check_weights(friction: &FrictionData, slip: Slip) -> Result<(), S
         return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed: friction.slip() });
     }
     Ok(())
-}
-
-/// `∂θ_k/∂Q` of hole `k` from `cable`'s rows; an error when the geometry was computed
-/// without the wrap gradients (`sinew_routing::compute_friction_angles` alone).
-#[inline]
-pub(crate) fn wrap_row<'a>(cable: &CableRows<'a>, k: usize) -> Result<DofRow<'a>, StiffnessError> {
-    match cable.wrap_gradient(k) {
-        Some(row) => Ok(row),
-        None => Err(StiffnessError::Routing(sinew_routing::RoutingError::FrictionNotComputed {
-            what: "wrap gradients",
-            call: "compute_wrap_gradients (or compute_friction_geometry)",
-        })),
-    }
 }
 
 /// `E A` of the routing's cables, N.

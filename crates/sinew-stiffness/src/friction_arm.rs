@@ -111,6 +111,8 @@ impl ArmStiffness {
         choice: TensionChoice<'_>,
     ) -> Result<EndOutcome, StiffnessError> {
         out.outcome = None;
+        // The friction geometry reads the routing's segment directions.
+        data.cables.keep_segment_directions(true);
         self.set_pose(data, q, f0)?;
         let routing = self.routing();
         // The stick regime's tensions and stiffness read no wrap gradient: the directional

@@ -24,7 +24,6 @@ use std::ops::Range;
 use sinew_routing::{CableRows, DofRow};
 
 use crate::error::StiffnessError;
-use crate::friction::wrap_row;
 use crate::holes::{Edges, Hole, HoleEvent};
 
 /// The least `α` so far, the place in the full pass's order of its hole, and its event.
@@ -79,7 +78,7 @@ impl HoleBounds {
             let mut before = cable.jacobian(0);
             let mut carried = false;
             for s in 1..cable.len() {
-                let (after, wrap) = (cable.jacobian(s), wrap_row(cable, s - 1)?);
+                let (after, wrap) = (cable.jacobian(s), cable.wrap_gradient(s - 1)?);
                 let (i, h, place) = match pending.next() {
                     Some((i, (h, place))) if (h.cable, h.hole + 1) == (c, s) => (i, h, place),
                     _ => {

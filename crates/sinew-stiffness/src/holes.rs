@@ -154,7 +154,7 @@ pub(crate) fn holes(
         let mut spring = lengths.first().map_or(0.0, |l| ea / l);
         for (k, (&theta, &kinked)) in angles.iter().zip(kinked).enumerate() {
             let next = ea / lengths[k + 1];
-            let lower = (-mu * theta).exp();
+            let lower = sinew_routing::capstan_factor(-mu * theta);
             out.push(Hole {
                 cable: c,
                 hole: k,

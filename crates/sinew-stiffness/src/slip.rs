@@ -63,7 +63,6 @@ use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData
 use crate::error::StiffnessError;
 use crate::friction::{
     FrictionRegime, FrictionStiffnessData, add_segment_hessians, axial_rigidity, check_weights,
-    wrap_row,
 };
 
 /// The joint stiffness of the slip regime `slip` at the actuator tensions `actuator` (m, N),
@@ -154,7 +153,7 @@ pub fn slip_stiffness(
                 }
                 (lo, hi) = (lo.min(j_s.dofs.start), hi.max(j_s.dofs.end));
             }
-            let theta = wrap_row(&cable, k)?;
+            let theta = cable.wrap_gradient(k)?;
             if theta.dofs.is_empty() {
                 continue;
             }

@@ -68,10 +68,25 @@ pub fn stick_stiffness(
             // J_sᵀ k_s J_s on and above the diagonal (mirrored below once every cable is in).
             let j_s = cable.jacobian(s);
             let k_s = ea / cable.lengths[s];
-            for (jj, j) in j_s.dofs.clone().enumerate() {
-                let kj = k_s * j_s.values[jj];
-                for (ii, i) in j_s.dofs.clone().enumerate().take(jj + 1) {
-                    *out.inherent.at_mut(i, j) += kj * j_s.values[ii];
+            let (lo, v) = (j_s.dofs.start, j_s.values);
+            let inherent = &mut out.inherent;
+            match *v {
+                [] => {}
+                // A segment across one universal joint (the common case), unrolled: the same
+                // products, added in the same order.
+                [v0, v1] => {
+                    let (k0, k1) = (k_s * v0, k_s * v1);
+                    *inherent.at_mut(lo, lo) += k0 * v0;
+                    *inherent.at_mut(lo, lo + 1) += k1 * v0;
+                    *inherent.at_mut(lo + 1, lo + 1) += k1 * v1;
+                }
+                _ => {
+                    for (jj, j) in j_s.dofs.clone().enumerate() {
+                        let kj = k_s * v[jj];
+                        for (ii, i) in j_s.dofs.clone().enumerate().take(jj + 1) {
+                            *inherent.at_mut(i, j) += kj * v[ii];
+                        }
+                    }
                 }
             }
         }

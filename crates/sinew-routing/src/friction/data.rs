@@ -96,12 +96,17 @@ impl<'a> CableRows<'a> {
     }
 
     /// `∂θ_k/∂Q` of hole `k` ([`FrictionData::wrap_gradient`]; empty for the anchor and for
-    /// `k ≥ H`); `None` when the wrap gradients were not computed
-    /// ([`crate::compute_friction_angles`] alone, [`FrictionData::check_wrap_gradients`]).
+    /// `k ≥ H`).
+    ///
+    /// # Errors
+    /// [`RoutingError::FrictionNotComputed`] when the wrap gradients were not computed
+    /// ([`crate::compute_friction_angles`] alone): [`FrictionData::check_wrap_gradients`]'s.
     #[inline]
-    pub fn wrap_gradient(&self, k: usize) -> Option<DofRow<'a>> {
-        let store = self.wrap_gradients?;
-        Some(self.entries.get(k).map_or(EMPTY, |e| row(store, &e.wrap)))
+    pub fn wrap_gradient(&self, k: usize) -> Result<DofRow<'a>> {
+        match self.wrap_gradients {
+            Some(store) => Ok(self.entries.get(k).map_or(EMPTY, |e| row(store, &e.wrap))),
+            None => Err(GRADIENTS_MISSING),
+        }
     }
 
     /// The routing segment friction segment `s` is (`None` for the free length, `s = 0`, and
@@ -129,8 +134,11 @@ pub struct FrictionData {
     pub(crate) lengths: Vec<f64>,
     /// `u_s` (base frame, unit, away from the actuator), per entry.
     pub(crate) directions: Vec<[f64; 3]>,
-    /// Hole `s` in the base frame, per entry.
+    /// Hole `s` in the base frame, per entry (computed by the wrap gradients' pass).
     pub(crate) positions: Vec<[f64; 3]>,
+    /// Each body's pose `[R (column-major), t]` (base frame) at the geometry's configuration,
+    /// one per body: where the wrap gradients' pass places the holes.
+    pub(crate) frames: Vec<[f64; 12]>,
     /// `J_s`, per entry's jacobian slot.
     pub(crate) jacobians: Vec<f64>,
     /// `θ_k` per entry (0 at the anchor).
@@ -141,6 +149,10 @@ pub struct FrictionData {
     pub(crate) wrap_gradients: Vec<f64>,
     /// `w_s`, per entry.
     pub(crate) weights: Vec<f64>,
+    /// Scratch, two values per entry: each hole's `|u_k × u_{k+1}|` and `u_k · u_{k+1}` (the
+    /// sine and cosine of its wrap angle), then each hole's capstan exponent `σμθ_k` (in `[0]`):
+    /// the inputs of `lanes.rs`.
+    pub(crate) scratch: [Vec<f64>; 2],
     /// `J̃_c`, m × dof, column-major.
     pub(crate) effective_jacobian: Vec<f64>,
     /// Each joint's axis `a_i` (base frame) at the geometry's configuration, one per DOF.
@@ -163,11 +175,13 @@ impl FrictionData {
             lengths: vec![0.0; n],
             directions: vec![[0.0; 3]; n],
             positions: vec![[0.0; 3]; n],
+            frames: vec![[0.0; 12]; model.dof + 1],
             jacobians: vec![0.0; model.jacobian_len],
             wrap: vec![0.0; n],
             kinked: vec![false; n],
             wrap_gradients: vec![0.0; model.wrap_len],
             weights: vec![0.0; n],
+            scratch: [vec![0.0; n], vec![0.0; n]],
             effective_jacobian: vec![0.0; m * model.dof],
             axes: vec![[0.0; 3]; model.dof],
             moments: vec![[0.0; 3]; model.dof],
@@ -354,10 +368,7 @@ impl FrictionData {
         if self.geometry && self.gradients {
             return Ok(());
         }
-        Err(RoutingError::FrictionNotComputed {
-            what: "wrap gradients",
-            call: "compute_wrap_gradients (or compute_friction_geometry)",
-        })
+        Err(GRADIENTS_MISSING)
     }
 
     /// Cable `c`'s entries, once the geometry is computed.
@@ -407,6 +418,12 @@ impl FrictionData {
 fn row<'a>(store: &'a [f64], slot: &Slot) -> DofRow<'a> {
     DofRow { dofs: slot.dofs.clone(), values: &store[slot.offset..slot.offset + slot.dofs.len()] }
 }
+
+/// The one error of every accessor of the wrap gradients before they are computed.
+const GRADIENTS_MISSING: RoutingError = RoutingError::FrictionNotComputed {
+    what: "wrap gradients",
+    call: "compute_wrap_gradients (or compute_friction_geometry)",
+};
 
 const WEIGHTS_MISSING: RoutingError =
     RoutingError::FrictionNotComputed { what: "capstan weights", call: "compute_capstan_weights" };

@@ -2,6 +2,7 @@
 //! `J_s`, every hole's wrap angle and its gradient (module docs of `crate::friction`).
 
 use super::data::FrictionData;
+use super::lanes::{atan2_all, sqrt_all};
 use super::model::{Entry, FrictionModel};
 use crate::error::{Result, RoutingError};
 use crate::geometry::{Kinematics, RoutingData, length_derivative};
@@ -51,7 +52,7 @@ pub fn compute_friction_geometry(
 /// stick regime's statics and stiffness read; [`compute_wrap_gradients`] adds `∂θ_k/∂Q` (the
 /// slip regimes, the directional response and the stick load limit need them). Until then
 /// [`FrictionData::wrap_gradient`] and [`FrictionData::weight_gradient`] answer
-/// [`RoutingError::FrictionNotComputed`] and [`crate::CableRows::wrap_gradient`] `None`.
+/// [`RoutingError::FrictionNotComputed`], and so does [`crate::CableRows::wrap_gradient`].
 ///
 /// Allocates nothing. On error `data` holds nothing valid.
 ///
@@ -73,22 +74,31 @@ pub fn compute_friction_angles(
     let kinematics = routing_data.kinematics();
     let segment_lengths = routing_data.segment_lengths()?;
     // With the routing's Jacobian at hand (Order::Jacobian and above), a cable whose segments
-    // cross distinct DOFs reads each J_s from J_c.
-    let j_c = routing_data.jacobian().ok();
+    // cross distinct DOFs reads each J_s from J_c, and every segment across joints its unit
+    // direction from the routing's (the same operations on the same holes: the same bits).
+    let j_c = routing_data.jacobian_entries().ok();
+    let m = model.cables.len();
+    let routing_directions = routing_data.directions();
     // Each joint's axis `a_i` and moment `m_i = a_i × p_i`, kept for the wrap gradients:
     // `(a_i × (x − p_i))·g = a_i·(x × g) − g·m_i`.
     for (i, (a, m)) in data.axes.iter_mut().zip(&mut data.moments).enumerate() {
         let (axis, origin) = joint(kinematics, i, model.dof)?;
         (*a, *m) = (*axis, cross(axis, origin));
     }
+    // The body poses, kept for the wrap gradients' hole positions.
+    if kinematics.0.len() != data.frames.len() {
+        return Err(mismatch(model.dof));
+    }
+    data.frames.copy_from_slice(kinematics.0);
+    // A hole in the base frame.
+    let place = |entry: &Entry| match kinematics.0.get(entry.hole_body) {
+        Some(frame) => Ok(transform(frame, &entry.hole_point)),
+        None => Err(mismatch(model.dof)),
+    };
     for (c, range) in model.cables.iter().enumerate() {
         let entries = &model.entries[range.clone()];
         let first = range.start;
-        // Hole positions, then each segment's length, direction and J_s.
-        for (s, entry) in entries.iter().enumerate() {
-            let frame = kinematics.0.get(entry.hole_body).ok_or_else(|| mismatch(model.dof))?;
-            data.positions[first + s] = transform(frame, &entry.hole_point);
-        }
+        // Each segment's length, direction and J_s.
         let entry_frame =
             kinematics.0.get(entries[0].hole_body).ok_or_else(|| mismatch(model.dof))?;
         data.lengths[first] = model.free_length[c];
@@ -97,32 +107,60 @@ pub fn compute_friction_angles(
             let r = entry.routing.ok_or_else(|| mismatch(model.dof))?;
             let slot = &entry.jacobian;
             let jacobian = &mut data.jacobians[slot.offset..slot.offset + slot.dofs.len()];
-            let holes = [data.positions[first + s - 1], data.positions[first + s]];
-            let u = match j_c {
-                Some(j_c) if model.disjoint[c] => {
+            // The routing's `u` (proximal to distal) of a segment across joints, in cable order;
+            // a segment within one body turns with it.
+            let routed = match (entry.rigid_direction, routing_directions) {
+                (Some(u), _) => {
+                    let frame =
+                        kinematics.0.get(entry.hole_body).ok_or_else(|| mismatch(model.dof))?;
+                    Some(rotate(frame, &u))
+                }
+                (None, Some(u)) if !entry.jacobian.dofs.is_empty() => {
+                    let u = u.get(r).ok_or_else(|| mismatch(model.dof))?;
+                    Some(if entry.reversed { scale(u, -1.0) } else { *u })
+                }
+                _ => None,
+            };
+            let u = match (j_c, routed) {
+                (Some(j_c), Some(u)) if model.disjoint[c] => {
                     // J_c over the segment's DOFs is this segment's J_s alone.
                     for (out, i) in jacobian.iter_mut().zip(slot.dofs.clone()) {
-                        *out = j_c[(c, i)];
+                        *out = j_c.get(c + i * m).copied().ok_or_else(|| mismatch(model.dof))?;
                     }
-                    direction(routing, r, &holes)?
+                    u
                 }
-                _ => segment(routing, r, entry, kinematics, &holes, jacobian)?,
+                _ => {
+                    // The segment's two holes, in cable order.
+                    let holes = [place(&entries[s - 1])?, place(entry)?];
+                    segment(routing, r, entry, kinematics, &holes, routed, jacobian)?
+                }
             };
             data.lengths[first + s] = segment_lengths[r];
             data.directions[first + s] = u;
         }
-        // Wrap angles at every hole but the anchor: one short loop of independent square roots
-        // and `atan2`s (they overlap in the processor). `libm`'s `atan2` (musl's, < 1 ulp): half
-        // the cost of glibc's.
+        // Each hole's squared sine and cosine; the anchor's (0, 1) give θ = 0.
+        let [sines, cosines] = &mut data.scratch;
         for k in 0..entries.len() - 1 {
             let e = first + k;
             let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
-            let sine = bend(&u_in, &u_out).1;
-            data.wrap[e] = libm::atan2(sine, dot(&u_in, &u_out));
-            data.kinked[e] = sine < WRAP_KINK;
+            let w = cross(&u_in, &u_out);
+            (sines[e], cosines[e]) = (dot(&w, &w), dot(&u_in, &u_out));
         }
-        data.wrap[first + entries.len() - 1] = 0.0;
-        data.kinked[first + entries.len() - 1] = false;
+        let anchor = first + entries.len() - 1;
+        (sines[anchor], cosines[anchor]) = (0.0, 1.0);
+    }
+    // Every hole's sine (the norm of the bend, as `bend` computes it) and `atan2` at once:
+    // `libm`'s `atan2` (musl's, < 1 ulp) bit for bit, several holes to a vector register
+    // (`lanes.rs`).
+    let [sines, cosines] = &mut data.scratch;
+    sqrt_all(sines);
+    atan2_all(sines, cosines, &mut data.wrap);
+    for (kinked, sine) in data.kinked.iter_mut().zip(sines.iter()) {
+        *kinked = *sine < WRAP_KINK;
+    }
+    for range in &model.cables {
+        // The anchor has no wrap angle, and no kink.
+        data.kinked[range.end - 1] = false;
     }
     data.geometry = true;
     Ok(())
@@ -148,6 +186,11 @@ pub fn compute_wrap_gradients(model: &FrictionModel, data: &mut FrictionData) ->
     }
     if data.gradients {
         return Ok(());
+    }
+    // Every hole in the base frame, at the angles' configuration.
+    for (position, entry) in data.positions.iter_mut().zip(&model.entries) {
+        let frame = data.frames.get(entry.hole_body).ok_or_else(|| mismatch(model.dof))?;
+        *position = transform(frame, &entry.hole_point);
     }
     for range in &model.cables {
         let entries = &model.entries[range.clone()];
@@ -245,20 +288,24 @@ fn direction(routing: &Routing, r: usize, holes: &[[f64; 3]; 2]) -> Result<[f64;
     Ok(scale(&d, 1.0 / length))
 }
 
-/// Friction segment `entry` (routing segment `r`): its unit direction away from the actuator,
-/// and `J_s` written into `jacobian` by the routing's own formula (for a cable with two
-/// segments across one DOF, where `J_c` holds their sum). `holes` are the segment's two holes
-/// in cable order (base frame).
+/// Friction segment `entry` (routing segment `r`): its unit direction away from the actuator
+/// (`routed`, the routing's, when it has one), and `J_s` written into `jacobian` by the
+/// routing's own formula (for a cable with two segments across one DOF, where `J_c` holds their
+/// sum). `holes` are the segment's two holes in cable order (base frame).
 fn segment(
     routing: &Routing,
     r: usize,
     entry: &Entry,
     (_, axes, origins): Kinematics<'_>,
     holes: &[[f64; 3]; 2],
+    routed: Option<[f64; 3]>,
     jacobian: &mut [f64],
 ) -> Result<[f64; 3]> {
     let seg = &routing.segments[r];
-    let u = direction(routing, r, holes)?;
+    let u = match routed {
+        Some(u) => u,
+        None => direction(routing, r, holes)?,
+    };
     if seg.dofs.is_empty() {
         return Ok(u);
     }

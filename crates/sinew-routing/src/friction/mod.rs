@@ -69,6 +69,7 @@
 
 mod data;
 mod geometry;
+mod lanes;
 mod model;
 mod weights;
 
@@ -77,4 +78,4 @@ pub use geometry::{
     WRAP_KINK, compute_friction_angles, compute_friction_geometry, compute_wrap_gradients,
 };
 pub use model::{FrictionModel, Slip};
-pub use weights::compute_capstan_weights;
+pub use weights::{capstan_factor, compute_capstan_weights};

@@ -7,7 +7,8 @@ use faer::MatRef;
 
 use crate::error::{Result, RoutingError};
 use crate::geometry::RoutingData;
-use crate::routing::Routing;
+use crate::routing::{MIN_SEGMENT_LENGTH, Routing};
+use crate::vec3::{dot, scale};
 
 /// The slip regime: which way every hole of a cable slides (spec §9). It sets the sign `σ` of
 /// the capstan exponent, `T_s = T_{s−1} e^{σ μ θ}`.
@@ -66,6 +67,9 @@ pub(crate) struct Entry {
     pub(crate) wrap: Slot,
     /// The DOFs of `∂w_s/∂Q`: the union of the wrap rows of holes `0 … s−1`.
     pub(crate) weight: Range<usize>,
+    /// For a segment within one body (constant length, `s ≥ 1`): its unit direction away from
+    /// the actuator in that body's frame, so that its direction at a pose is one rotation.
+    pub(crate) rigid_direction: Option<[f64; 3]>,
 }
 
 /// The immutable description of a routing's friction geometry (Pinocchio's *model*): built once
@@ -132,6 +136,17 @@ impl FrictionModel {
                     });
                 }
                 let p = holes[k].body_point.point;
+                let rigid_direction = match k {
+                    0 => None,
+                    _ if body(k - 1) != body(k) => None,
+                    _ => {
+                        let before = holes[k - 1].body_point.point;
+                        let d = [p.x - before.x, p.y - before.y, p.z - before.z];
+                        let length = dot(&d, &d).sqrt();
+                        // A degenerate one is left to the evaluation, which names it.
+                        (length >= MIN_SEGMENT_LENGTH).then(|| scale(&d, 1.0 / length))
+                    }
+                };
                 entries.push(Entry {
                     routing: routing_segment,
                     reversed,
@@ -140,6 +155,7 @@ impl FrictionModel {
                     hole_point: [p.x, p.y, p.z],
                     wrap: Slot::push(wrap_dofs, &mut wrap_len),
                     weight,
+                    rigid_direction,
                 });
             }
             cables.push(first..entries.len());

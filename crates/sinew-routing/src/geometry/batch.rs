@@ -29,7 +29,7 @@ pub(super) fn batched(
     plan: &SegmentPlan,
     kinematics: Kinematics<'_>,
     scratch_per_segment: (&mut [[f64; 3]], &mut [f64]),
-    scratch: &mut [Vec<f64>; 6],
+    scratch: &mut [Vec<f64>; 9],
     out: &mut Outputs<'_>,
 ) -> Result<()> {
     pulp::Arch::new().dispatch(Batched {
@@ -48,7 +48,7 @@ struct Batched<'a, 'b> {
     plan: &'a SegmentPlan,
     kinematics: Kinematics<'a>,
     scratch_per_segment: (&'a mut [[f64; 3]], &'a mut [f64]),
-    scratch: &'a mut [Vec<f64>; 6],
+    scratch: &'a mut [Vec<f64>; 9],
     out: &'a mut Outputs<'b>,
 }
 
@@ -68,7 +68,7 @@ fn batched_loop(
     plan: &SegmentPlan,
     (frames, axes, origins): Kinematics<'_>,
     (v, g): (&mut [[f64; 3]], &mut [f64]),
-    scratch: &mut [Vec<f64>; 6],
+    scratch: &mut [Vec<f64>; 9],
     out: &mut Outputs<'_>,
 ) -> Result<()> {
     let dof = routing.dof;
@@ -108,14 +108,14 @@ fn batched_loop(
             }
             continue;
         }
-        let [l, g0, g1, h00, h01, h11] = scratch.each_mut().map(|v| &mut v[..n]);
+        let [l, g0, g1, h00, h01, h11, ux, uy, uz] = scratch.each_mut().map(|v| &mut v[..n]);
         run_batch(
             &BatchFrames { proximal, distal, axes: a, origins: p },
             plan.proximal.each_ref().map(|c| &c[entries.clone()]),
             plan.distal.each_ref().map(|c| &c[entries.clone()]),
-            BatchOut { length: l, g: [g0, g1], h: [h00, h01, h11] },
+            BatchOut { length: l, g: [g0, g1], h: [h00, h01, h11], u: [ux, uy, uz] },
             joints,
-            hessians,
+            (hessians, out.directions.is_some()),
         );
         let (segments, cables) = (&plan.segment[entries.clone()], &plan.cable[entries.clone()]);
         // One vectorisable pass (NaN fails `>=`), the culprit searched only on failure.
@@ -127,6 +127,11 @@ fn batched_loop(
             out.segment_lengths[s] = length;
         }
         let derivatives = out.order >= Order::Jacobian;
+        if let Some(directions) = out.directions.as_deref_mut() {
+            for (i, &s) in segments.iter().enumerate() {
+                directions[s] = [ux[i], uy[i], uz[i]];
+            }
+        }
         match &batch.cables {
             // Consecutive cables: whole slices of the lengths and of J_c's columns.
             Some(range) => {
@@ -200,16 +205,19 @@ pub(crate) struct BatchFrames<'a> {
     pub(crate) origins: &'a [[f64; 3]],
 }
 
-/// A batch's results, one entry per segment: the length, `∂L/∂q` over its joints (`g[0..n]`)
-/// and the Hessian's upper triangle (`h[0]` = (0,0), `h[1]` = (0,1), `h[2]` = (1,1)).
+/// A batch's results, one entry per segment: the length, `∂L/∂q` over its joints (`g[0..n]`),
+/// the Hessian's upper triangle (`h[0]` = (0,0), `h[1]` = (0,1), `h[2]` = (1,1)) and the unit
+/// direction `u` by coordinate.
 pub(crate) struct BatchOut<'a> {
     pub(crate) length: &'a mut [f64],
     pub(crate) g: [&'a mut [f64]; 2],
     pub(crate) h: [&'a mut [f64]; 3],
+    pub(crate) u: [&'a mut [f64]; 3],
 }
 
 /// The batch's lengths and their derivatives, for one or two joints (`joints` ∈ {1, 2}; the
-/// caller takes longer segments one by one, and segments within one body from the plan). `hessians`: whether the Hessians are wanted.
+/// caller takes longer segments one by one, and segments within one body from the plan).
+/// `hessians`, `directions`: whether the Hessians and the unit directions are wanted.
 /// Inlined into the caller's pulp dispatch, so compiled with its vector instructions.
 #[inline(always)]
 pub(crate) fn run_batch(
@@ -218,13 +226,17 @@ pub(crate) fn run_batch(
     distal: [&[f64]; 3],
     out: BatchOut<'_>,
     joints: usize,
-    hessians: bool,
+    (hessians, directions): (bool, bool),
 ) {
-    match (joints, hessians) {
-        (1, false) => kernel::<1, false>(frames, proximal, distal, out),
-        (1, true) => kernel::<1, true>(frames, proximal, distal, out),
-        (2, false) => kernel::<2, false>(frames, proximal, distal, out),
-        (2, true) => kernel::<2, true>(frames, proximal, distal, out),
+    match (joints, hessians, directions) {
+        (1, false, false) => kernel::<1, false, false>(frames, proximal, distal, out),
+        (1, false, true) => kernel::<1, false, true>(frames, proximal, distal, out),
+        (1, true, false) => kernel::<1, true, false>(frames, proximal, distal, out),
+        (1, true, true) => kernel::<1, true, true>(frames, proximal, distal, out),
+        (2, false, false) => kernel::<2, false, false>(frames, proximal, distal, out),
+        (2, false, true) => kernel::<2, false, true>(frames, proximal, distal, out),
+        (2, true, false) => kernel::<2, true, false>(frames, proximal, distal, out),
+        (2, true, true) => kernel::<2, true, true>(frames, proximal, distal, out),
         _ => {}
     }
 }
@@ -232,7 +244,7 @@ pub(crate) fn run_batch(
 /// The per-segment computation of `segment.rs` (`transform`, `segment_derivatives::<N>`) over
 /// a batch, the same operations in the same order, one loop per batch.
 #[inline(always)]
-fn kernel<const N: usize, const H: bool>(
+fn kernel<const N: usize, const H: bool, const D: bool>(
     frames: &BatchFrames<'_>,
     proximal: [&[f64]; 3],
     distal: [&[f64]; 3],
@@ -242,9 +254,10 @@ fn kernel<const N: usize, const H: bool>(
     let (fa, fb) = (frames.proximal, frames.distal);
     let [ax, ay, az] = proximal.map(|c| &c[..n]);
     let [bx, by, bz] = distal.map(|c| &c[..n]);
-    let BatchOut { length, g: [g0, g1], h: [h00, h01, h11] } = out;
+    let BatchOut { length, g: [g0, g1], h: [h00, h01, h11], u: [ux, uy, uz] } = out;
     let (g0, g1, h00, h01, h11) =
         (&mut g0[..n], &mut g1[..n], &mut h00[..n], &mut h01[..n], &mut h11[..n]);
+    let (ux, uy, uz) = (&mut ux[..n], &mut uy[..n], &mut uz[..n]);
     let axis = |k: usize| frames.axes.get(k).copied().unwrap_or([0.0; 3]);
     let origin = |k: usize| frames.origins.get(k).copied().unwrap_or([0.0; 3]);
     let (a0, a1, p0, p1) = (axis(0), axis(1), origin(0), origin(1));
@@ -256,6 +269,9 @@ fn kernel<const N: usize, const H: bool>(
         length[i] = l;
         let inv_length = 1.0 / l;
         let u = scale(&d, inv_length);
+        if D {
+            (ux[i], uy[i], uz[i]) = (u[0], u[1], u[2]);
+        }
         let v0 = cross(&a0, &sub(&pb, &p0));
         let q0 = dot(&u, &v0);
         g0[i] = q0;

@@ -106,12 +106,15 @@ pub fn compute_cable_geometry_from_kinematics(
         data.jacobian.fill(0.0);
     }
     let m = data.cables;
+    let keep_directions = data.keep_directions && order >= Order::Jacobian;
+    data.directions_kept = false;
     let RoutingData {
         frames,
         axes,
         origins,
         lengths,
         segment_lengths,
+        directions,
         jacobian,
         hessians,
         v,
@@ -119,7 +122,8 @@ pub fn compute_cable_geometry_from_kinematics(
         batch,
         ..
     } = data;
-    let mut out = Outputs { lengths, segment_lengths, jacobian, hessians, m, order };
+    let directions = keep_directions.then_some(&mut directions[..]);
+    let mut out = Outputs { lengths, segment_lengths, directions, jacobian, hessians, m, order };
     match &routing.plan {
         Some(plan) => batched(routing, plan, (frames, axes, origins), (v, g), batch, &mut out)?,
         None => {
@@ -129,5 +133,6 @@ pub fn compute_cable_geometry_from_kinematics(
         }
     }
     data.computed = Some(order);
+    data.directions_kept = keep_directions;
     Ok(())
 }

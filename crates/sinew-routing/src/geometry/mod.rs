@@ -60,6 +60,13 @@ pub struct RoutingData {
     lengths: Vec<f64>,
     /// Length of every segment, m.
     segment_lengths: Vec<f64>,
+    /// Unit direction `u = d / L` of every segment across joints (proximal to distal hole,
+    /// base frame), when kept ([`RoutingData::keep_segment_directions`]) at [`Order::Jacobian`]
+    /// and above; unwritten for a segment within one body.
+    directions: Vec<[f64; 3]>,
+    /// Whether evaluations keep `directions`, and whether the last one did.
+    keep_directions: bool,
+    directions_kept: bool,
     /// `J_c`, m × dof, column-major.
     jacobian: Vec<f64>,
     /// Every segment's Hessian block (`|dofs| × |dofs|`, column-major), one after the other.
@@ -74,9 +81,9 @@ pub struct RoutingData {
     v: Vec<[f64; 3]>,
     /// Scratch: `u · v_i`.
     g: Vec<f64>,
-    /// Scratch of the batched segment loop: length, `∂L/∂q` (two), Hessian (three) per entry of
-    /// the longest batch ([`crate::routing::SegmentPlan`]; empty without a plan).
-    batch: [Vec<f64>; 6],
+    /// Scratch of the batched segment loop: length, `∂L/∂q` (two), Hessian (three), `u` (three)
+    /// per entry of the longest batch ([`crate::routing::SegmentPlan`]; empty without a plan).
+    batch: [Vec<f64>; 9],
 }
 
 impl RoutingData {
@@ -94,6 +101,9 @@ impl RoutingData {
                 .iter()
                 .map(|s| rigid_length(s).unwrap_or(0.0))
                 .collect(),
+            directions: vec![[0.0; 3]; routing.segments.len()],
+            keep_directions: false,
+            directions_kept: false,
             jacobian: vec![0.0; m * routing.dof],
             hessians: vec![0.0; routing.hessian_len],
             frames: vec![[0.0; 12]; routing.dof + 1],
@@ -247,6 +257,31 @@ impl RoutingData {
                 out[(lo + i, lo + k)] += w * block[i + k * n];
             }
         }
+    }
+
+    /// `J_c` as its column-major entries (`(c, i)` at `c + i m`), as [`RoutingData::jacobian`].
+    pub(crate) fn jacobian_entries(&self) -> Result<&[f64]> {
+        self.need(Order::Jacobian, "cable Jacobian")?;
+        Ok(&self.jacobian)
+    }
+
+    /// Whether the evaluations from now on also keep every segment's unit direction (off for a
+    /// new workspace). The friction geometry ([`crate::compute_friction_angles`]) reads them
+    /// instead of computing them again from the holes, which at 50 DOF is a tenth of a stick
+    /// evaluation; the frictionless pipeline needs none, and keeping them costs it about 5 %.
+    /// The values are the same bit for bit either way.
+    pub fn keep_segment_directions(&mut self, keep: bool) {
+        self.keep_directions = keep;
+    }
+
+    /// Every segment's unit direction `u = d / L` (proximal to distal hole, base frame; the `u`
+    /// of eq. 3), in the order of [`Routing::segments`], for the friction geometry: `Some` when
+    /// the last evaluation kept them ([`RoutingData::keep_segment_directions`]) with at least
+    /// [`Order::Jacobian`]. Valid for the segments across joints; a segment within one body
+    /// has none (its entry is stale).
+    pub(crate) fn directions(&self) -> Option<&[[f64; 3]]> {
+        self.need(Order::Jacobian, "segment directions").ok()?;
+        self.directions_kept.then_some(&self.directions[..])
     }
 
     /// The kinematics of the last evaluation as plain arrays (body frames, joint axes, joint

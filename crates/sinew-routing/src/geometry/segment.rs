@@ -12,6 +12,8 @@ use crate::vec3::{cross, dot, scale, sub, transform};
 pub(super) struct Outputs<'a> {
     pub(super) lengths: &'a mut [f64],
     pub(super) segment_lengths: &'a mut [f64],
+    /// Every segment's unit direction, when kept.
+    pub(super) directions: Option<&'a mut [[f64; 3]]>,
     pub(super) jacobian: &'a mut [f64],
     pub(super) hessians: &'a mut [f64],
     pub(super) m: usize,
@@ -61,6 +63,9 @@ pub(super) fn one_segment(
     }
     let inv_length = 1.0 / length;
     let u = scale(&d, inv_length);
+    if let Some(directions) = out.directions.as_deref_mut() {
+        directions[s] = u;
+    }
     let (lo, n, m) = (seg.dofs.start, seg.dofs.len(), out.m);
     let (Some(a), Some(p)) = (axes.get(lo..lo + n), origins.get(lo..lo + n)) else {
         return Err(mismatch(dof));
