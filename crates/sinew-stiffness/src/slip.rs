@@ -57,9 +57,10 @@
 //! [`crate::joint_stiffness`]'s bit for bit.
 
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Par};
+use faer::{Accum, MatRef, Par};
 use sinew_routing::{CableRows, FrictionData, FrictionModel, Routing, RoutingData, Slip};
 
+use crate::colmajor::ColMajor;
 use crate::error::StiffnessError;
 use crate::friction::{
     FrictionRegime, FrictionStiffnessData, add_segment_hessians, axial_rigidity, check_weights,
@@ -126,66 +127,95 @@ pub fn slip_stiffness(
     let n = out.dof;
     let FrictionStiffnessData { controllable, series_elastic, moving_series_t, suffix, .. } = out;
     suffix.fill(0.0);
-    for (c, &t_0) in actuator.iter().enumerate() {
-        if mu[c] == 0.0 {
-            continue;
-        }
-        let cable = friction.cable(model, c)?;
-        let Some(weights) = cable.weights else {
-            return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed: None });
-        };
-        let rate = slip.sign() * mu[c];
-        // C̃ = Σ_s c_s w_s, c_s = ℓ_s / (E A), in segment order.
-        let series: f64 = cable.lengths.iter().zip(weights).map(|(l, w)| l / ea * w).sum();
-        // From the anchor back: before hole k, S_k = Σ_{s>k} c_s w_s and
-        // G_k = σμ T_0 Σ_{s>k} w_s J_s (dense over `lo..hi`); then
-        // g += σμ S_k ∇θ_k and column j of K += ∂θ_k/∂q_j G_k.
-        let g = moving_series_t.col_mut(c);
-        let (mut s_k, mut lo, mut hi, mut g_lo, mut g_hi) = (0.0, n, 0, n, 0);
-        for k in (0..cable.len().saturating_sub(1)).rev() {
-            let s = k + 1;
-            s_k += cable.lengths[s] / ea * weights[s];
-            let j_s = cable.jacobian(s);
-            if !j_s.dofs.is_empty() {
-                let a = rate * t_0 * weights[s];
-                for (o, v) in suffix[j_s.dofs.clone()].iter_mut().zip(j_s.values) {
-                    *o += a * v;
-                }
-                (lo, hi) = (lo.min(j_s.dofs.start), hi.max(j_s.dofs.end));
-            }
-            let theta = cable.wrap_gradient(k)?;
-            if theta.dofs.is_empty() {
-                continue;
-            }
-            (g_lo, g_hi) = (g_lo.min(theta.dofs.start), g_hi.max(theta.dofs.end));
-            let rate_s = rate * s_k;
-            for (j, &d) in theta.dofs.clone().zip(theta.values) {
-                g[j] += rate_s * d;
-                if lo < hi {
-                    let column = &mut controllable.col_mut(j)[lo..hi];
-                    for (o, gk) in column.iter_mut().zip(&suffix[lo..hi]) {
-                        *o += d * gk;
-                    }
-                }
-            }
-        }
-        if lo < hi {
-            suffix[lo..hi].fill(0.0);
-        }
-        if g_lo < g_hi {
-            for v in &mut g[g_lo..g_hi] {
-                *v *= t_0 / series;
-            }
-        }
-        // The rows of J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
-        for j in routing.cables()[c].dofs.clone() {
-            *series_elastic.at_mut(c, j) = j_c[(c, j)] / series;
-        }
-    }
+    // Compiled with the processor's widest vectors (pulp's dispatch around the whole pass):
+    // the columns' updates `K[lo..hi, j] += ∂θ_k/∂q_j G_k` are most of a slip stiffness.
+    pulp::Arch::new().dispatch(SeriesPass {
+        parts: (model, routing, friction, j_c),
+        regime: (slip, ea, n),
+        actuator,
+        out: (controllable, series_elastic, moving_series_t, suffix),
+    })?;
     let (elastic, moving) = (out.series_elastic.as_ref(), out.moving_series_t.as_ref().transpose());
     let (inherent, controllable) = (out.inherent.as_mut(), out.controllable.as_mut());
     matmul(inherent, Accum::Add, j_tilde.transpose(), elastic, 1.0, Par::Seq);
     matmul(controllable, Accum::Add, j_tilde.transpose(), moving, -1.0, Par::Seq);
     out.finish(FrictionRegime::Slip(slip));
     Ok(())
+}
+
+/// The arguments of pass 2 of [`slip_stiffness`] as a pulp operation.
+struct SeriesPass<'a> {
+    parts: (&'a FrictionModel, &'a Routing, &'a FrictionData, MatRef<'a, f64>),
+    regime: (Slip, f64, usize),
+    actuator: &'a [f64],
+    out: (&'a mut ColMajor, &'a mut ColMajor, &'a mut ColMajor, &'a mut [f64]),
+}
+
+impl pulp::WithSimd for SeriesPass<'_> {
+    type Output = Result<(), StiffnessError>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
+        let SeriesPass { parts: (model, routing, friction, j_c), regime, actuator, out } = self;
+        let (slip, ea, n) = regime;
+        let (controllable, series_elastic, moving_series_t, suffix) = out;
+        let mu = model.friction_coefficients();
+        for (c, &t_0) in actuator.iter().enumerate() {
+            if mu[c] == 0.0 {
+                continue;
+            }
+            let cable = friction.cable(model, c)?;
+            let Some(weights) = cable.weights else {
+                return Err(StiffnessError::WrongCapstanWeights { needs: slip, computed: None });
+            };
+            let rate = slip.sign() * mu[c];
+            // C̃ = Σ_s c_s w_s, c_s = ℓ_s / (E A), in segment order.
+            let series: f64 = cable.lengths.iter().zip(weights).map(|(l, w)| l / ea * w).sum();
+            // From the anchor back: before hole k, S_k = Σ_{s>k} c_s w_s and
+            // G_k = σμ T_0 Σ_{s>k} w_s J_s (dense over `lo..hi`); then
+            // g += σμ S_k ∇θ_k and column j of K += ∂θ_k/∂q_j G_k.
+            let g = moving_series_t.col_mut(c);
+            let (mut s_k, mut lo, mut hi, mut g_lo, mut g_hi) = (0.0, n, 0, n, 0);
+            for k in (0..cable.len().saturating_sub(1)).rev() {
+                let s = k + 1;
+                s_k += cable.lengths[s] / ea * weights[s];
+                let j_s = cable.jacobian(s);
+                if !j_s.dofs.is_empty() {
+                    let a = rate * t_0 * weights[s];
+                    for (o, v) in suffix[j_s.dofs.clone()].iter_mut().zip(j_s.values) {
+                        *o += a * v;
+                    }
+                    (lo, hi) = (lo.min(j_s.dofs.start), hi.max(j_s.dofs.end));
+                }
+                let theta = cable.wrap_gradient(k)?;
+                if theta.dofs.is_empty() {
+                    continue;
+                }
+                (g_lo, g_hi) = (g_lo.min(theta.dofs.start), g_hi.max(theta.dofs.end));
+                let rate_s = rate * s_k;
+                for (j, &d) in theta.dofs.clone().zip(theta.values) {
+                    g[j] += rate_s * d;
+                    if lo < hi {
+                        let column = &mut controllable.col_mut(j)[lo..hi];
+                        for (o, gk) in column.iter_mut().zip(&suffix[lo..hi]) {
+                            *o += d * gk;
+                        }
+                    }
+                }
+            }
+            if lo < hi {
+                suffix[lo..hi].fill(0.0);
+            }
+            if g_lo < g_hi {
+                for v in &mut g[g_lo..g_hi] {
+                    *v *= t_0 / series;
+                }
+            }
+            // The rows of J̃ᵀ (J_c − T_0 g) / C̃, split into its two parts.
+            for j in routing.cables()[c].dofs.clone() {
+                *series_elastic.at_mut(c, j) = j_c[(c, j)] / series;
+            }
+        }
+        Ok(())
+    }
 }
