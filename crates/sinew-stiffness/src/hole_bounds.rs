@@ -147,14 +147,14 @@ impl HoleBounds {
     /// Along the joint motion `dq`, every grouped hole that may be reached no later than
     /// `best` is handed to `exact` (which computes it and updates `best`): first the hole whose
     /// bound is least, then, group by group in order, the others not skipped on their bound.
-    /// `scratch` is resized to the number of groups.
+    /// `scratch` is resized to the number of groups. The first error of `exact` ends it.
     pub(crate) fn search(
         &self,
         dq: &[f64],
         scratch: &mut Vec<(f64, f64)>,
         best: &mut Best,
-        mut exact: impl FnMut(usize, &mut Best),
-    ) {
+        mut exact: impl FnMut(usize, &mut Best) -> Result<(), StiffnessError>,
+    ) -> Result<(), StiffnessError> {
         scratch.clear();
         // Per group: its bound and the largest `|δQ_i|` over its DOFs.
         scratch.extend(self.groups.iter().map(|group| {
@@ -163,7 +163,7 @@ impl HoleBounds {
         }));
         let least = (0..scratch.len()).min_by(|&a, &b| scratch[a].0.total_cmp(&scratch[b].0));
         if let Some(g) = least {
-            exact(self.groups[g].seed, best);
+            exact(self.groups[g].seed, best)?;
         }
         for (group, &(bound, motion)) in self.groups.iter().zip(scratch.iter()) {
             if !may_reach(bound, best.0) {
@@ -171,10 +171,11 @@ impl HoleBounds {
             }
             for &(beta, i) in &self.members[group.members.clone()] {
                 if may_reach(beta / motion, best.0) {
-                    exact(i, best);
+                    exact(i, best)?;
                 }
             }
         }
+        Ok(())
     }
 }
 

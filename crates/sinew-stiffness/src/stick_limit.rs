@@ -235,10 +235,11 @@ fn along(
                 let rates = [
                     h.springs[1] * dot(&rows.jacobian(h.hole + 1), dq),
                     h.springs[0] * dot(&rows.jacobian(h.hole), dq),
-                    rows.wrap_gradient(h.hole).map_or(0.0, |g| dot(&g, dq)), // (Checked above.)
+                    dot(&rows.wrap_gradient(h.hole)?, dq),
                 ];
                 check(h, i, &h.edges(), rates, best, at_once);
-            });
+                Ok(())
+            })?;
         }
         (limit.magnitude, limit.first) = match limit.at_once.first() {
             Some(&event) => (0.0, Some(event)),
