@@ -98,6 +98,11 @@ impl ArmStiffness {
     /// `sinew_routing::compute_wrap_gradients(model, &mut out.friction)` before
     /// [`crate::directional_response`] or [`crate::stick_load_limits`] on it.
     ///
+    /// It turns on `data.cables`' kept segment directions
+    /// (`sinew_routing::RoutingData::keep_segment_directions`), which the friction geometry reads;
+    /// a frictionless [`ArmStiffness::evaluate`] on the same workspace then keeps them too (about
+    /// 5 % more instructions) until turned off there.
+    ///
     /// # Errors
     /// Those of the pose stage, the statics, [`crate::stick_stiffness`] (μ = 0 in
     /// the stick regime) and [`crate::slip_stiffness`]; numerical failures of the end stage.
