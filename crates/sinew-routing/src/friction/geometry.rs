@@ -74,8 +74,9 @@ pub fn compute_friction_angles(
     let kinematics = routing_data.kinematics();
     let segment_lengths = routing_data.segment_lengths()?;
     // With the routing's Jacobian at hand (Order::Jacobian and above), a cable whose segments
-    // cross distinct DOFs reads each J_s from J_c, and every segment across joints its unit
-    // direction from the routing's (the same operations on the same holes: the same bits).
+    // cross distinct DOFs reads each J_s from J_c, and, when the routing kept them
+    // (`RoutingData::keep_segment_directions`), every segment across joints its unit direction
+    // from the routing's (the same operations on the same holes: the same bits).
     let j_c = routing_data.jacobian_entries().ok();
     let m = model.cables.len();
     let routing_directions = routing_data.directions();

@@ -12,9 +12,9 @@ use crate::error::{Result, RoutingError};
 /// regime in turn on one geometry.
 ///
 /// # Math
-/// `w_0 = 1`, `w_s = w_{s−1} e^{σ μ θ_{s−1}}` (`libm`'s `exp`) (`σ` = [`Slip::sign`]: −1 pull, +1 release; `μ`
-/// the cable's), `J̃_c = Σ_{s ≥ 1} w_s J_s` summed in
-/// segment order from 0. At μ = 0 every `w_s` is exactly 1 and `J̃_c` is `J_c` bit for bit.
+/// `w_0 = 1`, `w_s = w_{s−1} e^{σ μ θ_{s−1}}` (`σ` = [`Slip::sign`]: −1 pull, +1 release; `μ`
+/// the cable's; the factors by `libm`'s `exp`, [`capstan_factor`] bit for bit),
+/// `J̃_c = Σ_{s ≥ 1} w_s J_s` summed in segment order from 0. At μ = 0 every `w_s` is exactly 1 and `J̃_c` is `J_c` bit for bit.
 ///
 /// # Errors
 /// [`RoutingError::WorkspaceMismatch`] for a workspace of another model,
