@@ -73,10 +73,6 @@ pub fn compute_friction_angles(
     data.slip = None;
     let kinematics = routing_data.kinematics();
     let segment_lengths = routing_data.segment_lengths()?;
-    // With the routing's Jacobian at hand (Order::Jacobian and above), a cable whose segments
-    // cross distinct DOFs reads each J_s from J_c, and, when the routing kept them
-    // (`RoutingData::keep_segment_directions`), every segment across joints its unit direction
-    // from the routing's (the same operations on the same holes: the same bits).
     let j_c = routing_data.jacobian_entries().ok();
     let m = model.cables.len();
     let routing_directions = routing_data.directions();
@@ -96,58 +92,76 @@ pub fn compute_friction_angles(
         Some(frame) => Ok(transform(frame, &entry.hole_point)),
         None => Err(mismatch(model.dof)),
     };
+    // The free lengths: along each cable's entry direction, turned with its first hole's body.
     for (c, range) in model.cables.iter().enumerate() {
-        let entries = &model.entries[range.clone()];
         let first = range.start;
-        // Each segment's length, direction and J_s.
+        let body = model.entries.get(first).map(|e| e.hole_body);
         let entry_frame =
-            kinematics.0.get(entries[0].hole_body).ok_or_else(|| mismatch(model.dof))?;
+            body.and_then(|b| kinematics.0.get(b)).ok_or_else(|| mismatch(model.dof))?;
         data.lengths[first] = model.free_length[c];
         data.directions[first] = rotate(entry_frame, &model.entry_direction[c]);
-        for (s, entry) in entries.iter().enumerate().skip(1) {
-            let r = entry.routing.ok_or_else(|| mismatch(model.dof))?;
-            let slot = &entry.jacobian;
-            let jacobian = &mut data.jacobians[slot.offset..slot.offset + slot.dofs.len()];
-            // The routing's `u` (proximal to distal) of a segment across joints, in cable order;
-            // a segment within one body turns with it.
-            let routed = match (entry.rigid_direction, routing_directions) {
-                (Some(u), _) => {
-                    let frame =
-                        kinematics.0.get(entry.hole_body).ok_or_else(|| mismatch(model.dof))?;
-                    Some(rotate(frame, &u))
-                }
-                (None, Some(u)) if !entry.jacobian.dofs.is_empty() => {
-                    let u = u.get(r).ok_or_else(|| mismatch(model.dof))?;
-                    Some(if entry.reversed { scale(u, -1.0) } else { *u })
-                }
-                _ => None,
+    }
+    // Each other segment's length, direction and J_s. With the routing's Jacobian at hand
+    // (Order::Jacobian and above) and its directions kept (`RoutingData::keep_segment_directions`),
+    // a segment across joints of a cable whose segments cross distinct DOFs copies them: its
+    // J_s is J_c over its DOFs, its direction the routing's (`FrictionModel::copied`, packed).
+    // Either way the same operations ran on the same holes: the same bits.
+    let copy = j_c.zip(routing_directions);
+    if let Some((j_c, directions)) = copy {
+        for s in &model.copied {
+            let (Some(u), Some(&length)) =
+                (directions.get(s.routing), segment_lengths.get(s.routing))
+            else {
+                return Err(mismatch(model.dof));
             };
-            let u = match (j_c, routed) {
-                (Some(j_c), Some(u)) if model.disjoint[c] => {
-                    // J_c over the segment's DOFs is this segment's J_s alone.
-                    for (out, i) in jacobian.iter_mut().zip(slot.dofs.clone()) {
-                        *out = j_c.get(c + i * m).copied().ok_or_else(|| mismatch(model.dof))?;
-                    }
-                    u
-                }
-                _ => {
-                    // The segment's two holes, in cable order.
-                    let holes = [place(&entries[s - 1])?, place(entry)?];
-                    segment(routing, r, entry, kinematics, &holes, routed, jacobian)?
-                }
-            };
-            data.lengths[first + s] = segment_lengths[r];
-            data.directions[first + s] = u;
+            data.directions[s.entry] = *u;
+            data.lengths[s.entry] = length;
+            let jacobian = &mut data.jacobians[s.offset..s.offset + s.dofs];
+            for (out, i) in jacobian.iter_mut().zip(s.dofs_start..) {
+                *out = j_c.get(s.cable + i * m).copied().ok_or_else(|| mismatch(model.dof))?;
+            }
         }
-        // Each hole's squared sine and cosine; the anchor's (0, 1) give θ = 0.
-        let [sines, cosines] = &mut data.scratch;
-        for k in 0..entries.len() - 1 {
-            let e = first + k;
-            let (u_in, u_out) = (data.directions[e], data.directions[e + 1]);
-            let w = cross(&u_in, &u_out);
-            (sines[e], cosines[e]) = (dot(&w, &w), dot(&u_in, &u_out));
-        }
-        let anchor = first + entries.len() - 1;
+    }
+    // A segment within one body: its body-frame direction turned, no J_s.
+    for s in &model.turned {
+        let (Some(frame), Some(&length)) =
+            (kinematics.0.get(s.body), segment_lengths.get(s.routing))
+        else {
+            return Err(mismatch(model.dof));
+        };
+        data.directions[s.entry] = rotate(frame, &s.direction);
+        data.lengths[s.entry] = length;
+    }
+    // The other segments across joints (and, without the routing's Jacobian or directions,
+    // the copied ones too), from their holes by the routing's formula: J_s, and the direction
+    // unless the routing kept it (turned for a segment run distal to proximal).
+    let copied = model.copied.iter().map(|s| s.entry).filter(|_| copy.is_none());
+    for e in model.placed.iter().copied().chain(copied) {
+        let entry = &model.entries[e];
+        let r = entry.routing.ok_or_else(|| mismatch(model.dof))?;
+        let slot = &entry.jacobian;
+        let jacobian = &mut data.jacobians[slot.offset..slot.offset + slot.dofs.len()];
+        let routed = match routing_directions {
+            Some(u) if !entry.jacobian.dofs.is_empty() => {
+                let u = u.get(r).ok_or_else(|| mismatch(model.dof))?;
+                Some(if entry.reversed { scale(u, -1.0) } else { *u })
+            }
+            _ => None,
+        };
+        // The segment's two holes, in cable order.
+        let holes = [place(&model.entries[e - 1])?, place(entry)?];
+        data.directions[e] = segment(routing, r, entry, kinematics, &holes, routed, jacobian)?;
+        data.lengths[e] = segment_lengths[r];
+    }
+    // Each hole's squared sine and cosine; the anchors' (0, 1) give θ = 0.
+    let [sines, cosines] = &mut data.scratch;
+    let pairs = data.directions.windows(2).zip(sines.iter_mut().zip(cosines.iter_mut()));
+    for (u, (sine, cosine)) in pairs {
+        let w = cross(&u[0], &u[1]);
+        (*sine, *cosine) = (dot(&w, &w), dot(&u[0], &u[1]));
+    }
+    for range in &model.cables {
+        let anchor = range.end - 1;
         (sines[anchor], cosines[anchor]) = (0.0, 1.0);
     }
     // Every hole's sine (the norm of the bend, as `bend` computes it) and `atan2` at once:

@@ -72,6 +72,43 @@ pub(crate) struct Entry {
     pub(crate) rigid_direction: Option<[f64; 3]>,
 }
 
+/// A friction segment the friction angles can copy whole from the routing's evaluation: one
+/// across joints, run proximal to distal, of a cable whose segments cross distinct DOFs, so
+/// that its `J_s` is `J_c` over its DOFs and its direction the routing's (`crate::friction`'s
+/// geometry, when the routing kept both). Packed, so that the pass over every such segment
+/// reads a few contiguous bytes per segment instead of its [`Entry`].
+///
+/// Such a cable never runs back: its holes lie on the bodies up to its anchor's, so a segment
+/// run distal to proximal across a joint is followed by one across the same joint again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Copied {
+    /// Its index in [`FrictionModel::entries`].
+    pub(crate) entry: usize,
+    /// Its cable.
+    pub(crate) cable: usize,
+    /// Its segment in [`Routing::segments`].
+    pub(crate) routing: usize,
+    /// Its first DOF and where its `J_s` starts in the store of rows.
+    pub(crate) dofs_start: usize,
+    pub(crate) offset: usize,
+    /// How many DOFs it crosses (at least one).
+    pub(crate) dofs: usize,
+}
+
+/// A friction segment within one body (`s ≥ 1`): a constant length, no `J_s`, and a direction
+/// that turns with its body (the friction angles' geometry). Packed, as [`Copied`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Turned {
+    /// Its index in [`FrictionModel::entries`].
+    pub(crate) entry: usize,
+    /// Its segment in [`Routing::segments`].
+    pub(crate) routing: usize,
+    /// The body it lies in.
+    pub(crate) body: usize,
+    /// [`Entry::rigid_direction`].
+    pub(crate) direction: [f64; 3],
+}
+
 /// The immutable description of a routing's friction geometry (Pinocchio's *model*): built once
 /// by [`FrictionModel::new`] from a [`Routing`], read by [`crate::compute_friction_geometry`]
 /// and [`crate::compute_capstan_weights`], which write a [`crate::FrictionData`].
@@ -92,9 +129,12 @@ pub struct FrictionModel {
     pub(crate) entry_direction: Vec<[f64; 3]>,
     /// Each cable's free length, m.
     pub(crate) free_length: Vec<f64>,
-    /// Per cable: whether no two of its segments cross the same DOF, so that each `J_s` is
-    /// `J_c` over the segment's DOFs (the routing's own values, bit for bit).
-    pub(crate) disjoint: Vec<bool>,
+    /// The segments after the free lengths, as the friction angles visit them: those they copy
+    /// from the routing when it kept its Jacobian and directions, those within one body, and
+    /// the others (their entries), each in entry order.
+    pub(crate) copied: Vec<Copied>,
+    pub(crate) turned: Vec<Turned>,
+    pub(crate) placed: Vec<usize>,
     pub(crate) jacobian_len: usize,
     pub(crate) wrap_len: usize,
 }
@@ -160,6 +200,48 @@ impl FrictionModel {
             }
             cables.push(first..entries.len());
         }
+        // Per cable: whether no two of its segments cross the same DOF, so that each `J_s` is
+        // `J_c` over the segment's DOFs (the routing's own values, bit for bit).
+        let disjoint: Vec<bool> = routing
+            .cables
+            .iter()
+            .map(|c| disjoint(&routing.segments[c.segments.clone()]))
+            .collect();
+        let (mut copied, mut turned, mut placed) = (Vec::new(), Vec::new(), Vec::new());
+        for (c, range) in cables.iter().enumerate() {
+            for (e, entry) in entries.iter().enumerate().take(range.end).skip(range.start + 1) {
+                match entry.routing {
+                    Some(routing)
+                        if disjoint[c]
+                            && !entry.reversed
+                            && entry.rigid_direction.is_none()
+                            && !entry.jacobian.dofs.is_empty() =>
+                    {
+                        copied.push(Copied {
+                            entry: e,
+                            cable: c,
+                            routing,
+                            dofs_start: entry.jacobian.dofs.start,
+                            offset: entry.jacobian.offset,
+                            dofs: entry.jacobian.dofs.len(),
+                        });
+                    }
+                    Some(routing) if entry.jacobian.dofs.is_empty() => {
+                        if let Some(direction) = entry.rigid_direction {
+                            turned.push(Turned {
+                                entry: e,
+                                routing,
+                                body: entry.hole_body,
+                                direction,
+                            });
+                        } else {
+                            placed.push(e);
+                        }
+                    }
+                    _ => placed.push(e),
+                }
+            }
+        }
         FrictionModel {
             source: routing.source.clone(),
             dof: routing.dof,
@@ -173,11 +255,9 @@ impl FrictionModel {
                 .map(|c| [c.entry_in_body.x, c.entry_in_body.y, c.entry_in_body.z])
                 .collect(),
             free_length: routing.cables.iter().map(|c| c.free_length).collect(),
-            disjoint: routing
-                .cables
-                .iter()
-                .map(|c| disjoint(&routing.segments[c.segments.clone()]))
-                .collect(),
+            copied,
+            turned,
+            placed,
             jacobian_len,
             wrap_len,
         }
