@@ -88,8 +88,9 @@ pub(crate) struct Copied {
     pub(crate) cable: usize,
     /// Its segment in [`Routing::segments`].
     pub(crate) routing: usize,
-    /// Its first DOF and where its `J_s` starts in the store of rows.
+    /// Its first DOF.
     pub(crate) dofs_start: usize,
+    /// Where its `J_s` starts in the store of rows ([`Entry::jacobian`]'s offset).
     pub(crate) offset: usize,
     /// How many DOFs it crosses (at least one).
     pub(crate) dofs: usize,
