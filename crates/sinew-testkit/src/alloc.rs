@@ -18,7 +18,10 @@
 //! ```
 //!
 //! The counter is global (every thread), as the allocations it must catch may happen on any
-//! thread: keep one counting `#[test]` per test binary, so no other test runs beside it.
+//! thread. So a counting test binary is a plain one (`harness = false` for its `[[test]]` in
+//! Cargo.toml, its checks called one after another from `main`): libtest's own thread
+//! allocates for its bookkeeping (starting a test, recording a result) while a test runs, and
+//! the counter would count it, now and then (about one run in 200 on a loaded machine).
 // The workspace denies unsafe code; `GlobalAlloc` is an unsafe trait, and this module is the
 // one place it is implemented, forwarding every call unchanged to the system allocator.
 #![allow(unsafe_code)]
