@@ -328,7 +328,7 @@ impl ArmStiffness {
         // (`end_compliance` with a dense K_W computes the same numbers).
         let joint_end = data.statics.joint_end();
         let stable = end_compliance_generated(
-            &data.k_q,
+            (&data.k_q, true),
             joint_end.generators(),
             joint_end.j_x(),
             &mut data.end,

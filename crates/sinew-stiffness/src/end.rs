@@ -116,15 +116,16 @@ pub fn end_compliance(
 /// besides those two. Returns `Ok(false)` when the symmetric part is not positive definite
 /// (the caller reports the smallest eigenvalue).
 ///
-/// `k_q` must be exactly symmetric, as the pipeline builds it (its parts are written in
-/// symmetric pairs; `tests/routed.rs` checks it): when `K_W` is symmetric too (no moment in
-/// `F0`), only the lower triangle of `K_q + K_W` is formed, straight into the storage of the
-/// Cholesky factor.
+/// `k_q_symmetric` says that `k_q` is exactly symmetric, as the frictionless pipeline and the
+/// stick regime build it (their parts are written in symmetric pairs; `tests/routed.rs` and
+/// the stick tests check it): when `K_W` is symmetric too (no moment in `F0`), only the lower
+/// triangle of `K_q + K_W` is then formed, straight into the storage of the Cholesky factor.
+/// A slip `K_q` is not symmetric: it takes the general branch.
 ///
 /// # Errors
 /// [`StiffnessError::NonFinite`]; [`StiffnessError::DimensionMismatch`].
 pub(crate) fn end_compliance_generated(
-    k_q: &ColMajor,
+    (k_q, k_q_symmetric): (&ColMajor, bool),
     k_w: &KwGenerators,
     j_x: MatRef<'_, f64>,
     data: &mut EndStiffnessData,
@@ -138,7 +139,7 @@ pub(crate) fn end_compliance_generated(
     }
     let mismatch =
         |_| StiffnessError::DimensionMismatch { what: "K_W", expected: n, got: k_w.len() };
-    if k_w.is_symmetric() {
+    if k_q_symmetric && k_w.is_symmetric() {
         // K_q (symmetric by construction) + K_W (symmetric: no moment in F0) is its own
         // symmetric part: its lower triangle, formed in place of the Cholesky factor, is all
         // the solve needs (the same numbers as the general branch: 0.5 · (l + l) = l).

@@ -155,6 +155,12 @@ impl FrictionStiffnessData {
         Ok(self.skew_norm)
     }
 
+    /// [`FrictionStiffnessData::stiffness`]'s storage (the end stage reads its columns).
+    pub(crate) fn stiffness_storage(&self) -> Result<&ColMajor, StiffnessError> {
+        self.computed()?;
+        Ok(&self.stiffness)
+    }
+
     fn computed(&self) -> Result<(), StiffnessError> {
         match self.regime {
             Some(_) => Ok(()),
@@ -196,11 +202,20 @@ impl FrictionStiffnessData {
     }
 
     /// `K = K_c + K_i`, its symmetric part and the norm of its skew part; then the regime.
+    /// A stick `K` is exactly symmetric (both parts are written in symmetric pairs, module docs
+    /// of `stick.rs`; its tests check `K = Kᵀ` bit for bit): its symmetric part is `K` and its
+    /// skew part 0, with no pass over the pairs.
     pub(crate) fn finish(&mut self, regime: FrictionRegime) {
         let n = self.dof;
         let (c, i) = (self.controllable.as_slice(), self.inherent.as_slice());
         for ((k, c), i) in self.stiffness.as_mut_slice().iter_mut().zip(c).zip(i) {
             *k = c + i;
+        }
+        if let FrictionRegime::Stick(_) = regime {
+            self.symmetric.as_mut_slice().copy_from_slice(self.stiffness.as_slice());
+            self.skew_norm = 0.0;
+            self.regime = Some(regime);
+            return;
         }
         // Each pair (r, j), (j, r) once: the symmetric part's two equal entries, and the skew
         // part's two equal squares.

@@ -29,7 +29,7 @@ use sinew_statics::{
 
 use crate::arm::ArmStiffness;
 use crate::data::{ArmStiffnessData, EndOutcome};
-use crate::end::{end_stiffness, stability_margin};
+use crate::end::{end_compliance_generated, stability_margin};
 use crate::end_data::EndStiffnessData;
 use crate::error::StiffnessError;
 use crate::friction::{FrictionRegime, FrictionStiffnessData};
@@ -168,18 +168,26 @@ impl ArmStiffness {
                 stick_stiffness(model, routing, geometry, f, history, t, k)?
             }
         }
-        data.fill_k_w();
-        let (k_q, k_w, j_x) =
-            (out.stiffness.stiffness()?, data.k_w_filled.as_ref(), data.statics.joint_end().j_x());
-        let outcome = match end_stiffness(k_q, k_w, j_x, &mut out.end) {
-            Ok(()) => EndOutcome::Stiff,
-            Err(StiffnessError::Unstable { min_eigenvalue }) => {
-                EndOutcome::Unstable { min_eigenvalue }
+        // The arm's dense end stage (`end_compliance_generated`: `K_W` from its generators,
+        // the same sums as `end_stiffness` with the dense `K_W`); a stick `K_q` is exactly
+        // symmetric, a slip one is not.
+        let joint_end = data.statics.joint_end();
+        let k_q = (out.stiffness.stiffness_storage()?, matches!(regime, FrictionRegime::Stick(_)));
+        let stable =
+            end_compliance_generated(k_q, joint_end.generators(), joint_end.j_x(), &mut out.end)?;
+        let outcome = if !stable {
+            // Not positive definite: the smallest eigenvalue, from the dense K_W.
+            data.fill_k_w();
+            let min_eigenvalue = stability_margin(k_q.0.as_ref(), data.k_w_filled.as_ref())?;
+            EndOutcome::Unstable { min_eigenvalue }
+        } else {
+            match out.end.invert_compliance() {
+                Ok(()) => EndOutcome::Stiff,
+                Err(StiffnessError::RankDeficient { pivot_ratio }) => {
+                    EndOutcome::RankDeficient { pivot_ratio }
+                }
+                Err(e) => return Err(e),
             }
-            Err(StiffnessError::RankDeficient { pivot_ratio }) => {
-                EndOutcome::RankDeficient { pivot_ratio }
-            }
-            Err(e) => return Err(e),
         };
         out.outcome = Some(outcome);
         Ok(outcome)

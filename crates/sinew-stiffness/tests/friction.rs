@@ -294,6 +294,9 @@ fn stick_stiffness_matches_the_hessian_of_the_segment_springs_energy() {
                 worst(&mut acc, k_stick, fd.as_ref());
                 // Exactly symmetric, and affine in the actuator tensions: the controllable part
                 // doubles with them, the inherent part does not move.
+                // (Checked on K itself: the workspace takes a stick K's symmetry as given.)
+                assert_eq!(k_stick, k_stick.transpose(), "{case}: {history:?}");
+                assert_eq!(out.symmetric_part().unwrap(), k_stick, "{case}: {history:?}");
                 assert_eq!(out.skew_norm().unwrap(), 0.0, "{case}: {history:?}");
                 let t2: Vec<f64> = t.iter().map(|t| 2.0 * t).collect();
                 stick_stiffness(args.0, args.1, args.2, args.3, args.4, &t2, &mut twice).unwrap();

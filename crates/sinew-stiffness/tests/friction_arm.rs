@@ -12,9 +12,9 @@ use nalgebra::Vector6;
 use sinew_routing::{FrictionModel, RoutingError, Slip, compute_wrap_gradients};
 use sinew_statics::{StaticsError, TensionChoice, TensionPolicy};
 use sinew_stiffness::{
-    ArmStiffness, ArmStiffnessData, BandEdge, EndOutcome, FrictionArmData, FrictionRegime, History,
-    HoleEvent, StiffnessError, base_directions, directional_response, sliding_response,
-    stick_load_limits,
+    ArmStiffness, ArmStiffnessData, BandEdge, EndOutcome, EndStiffnessData, FrictionArmData,
+    FrictionRegime, History, HoleEvent, StiffnessError, base_directions, directional_response,
+    end_stiffness, sliding_response, stick_load_limits,
 };
 use sinew_testkit::cdhrm5;
 
@@ -98,6 +98,9 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
                 }
             }
             assert!(out.stability_margin(&mut data).unwrap() > 0.0);
+            // The pipeline's end stage (K_W from its generators) is `end_stiffness` on the
+            // dense K_W, bit for bit.
+            same_end_as_dense(&out, &mut data, &format!("{pattern:?} {regime:?}"));
         }
         // Stick after equal takes the frictionless statics' tensions (any choice, levels too).
         let levels = TensionChoice::Levels(&[0.5; 5]);
@@ -150,6 +153,41 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
 /// of sliding holes from `0.375 λ` to `2.15 λ`, where some sliding sets leave an indefinite
 /// arm; beyond, a consistent set whose arm is unstable) turns each answer into its typed
 /// refusal. The same hole named twice makes the increment's system singular.
+/// `out.end` is `end_stiffness` on the regime's `K_q` and the dense `K_W`, bit for bit.
+fn same_end_as_dense(out: &FrictionArmData, data: &mut ArmStiffnessData, what: &str) {
+    let k_q = out.stiffness.stiffness().unwrap().to_owned();
+    let (k_w, j_x) = (data.k_w().to_owned(), data.j_x().to_owned());
+    let mut dense = EndStiffnessData::new(k_q.nrows());
+    end_stiffness(k_q.as_ref(), k_w.as_ref(), j_x.as_ref(), &mut dense).unwrap();
+    assert_eq!(dense.compliance(), out.end.compliance(), "{what}");
+    assert_eq!(dense.stiffness(), out.end.stiffness(), "{what}");
+}
+
+/// With a moment in the load `K_W` is not symmetric: the end stage's general branch, for the
+/// symmetric stick `K_q` as for the slip one, still `end_stiffness`'s numbers bit for bit.
+#[test]
+fn a_load_with_a_moment_ends_as_the_dense_stage() {
+    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.3, 0.0, 0.2);
+    let q = cdhrm5::LOADED_POSE;
+    for pattern in cdhrm5::MODELS {
+        let (robot, routing) = cdhrm5::robot_and_routing(pattern);
+        let arm = ArmStiffness::new(&robot, &routing).unwrap();
+        let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
+        let mut data = ArmStiffnessData::new(&arm);
+        let mut out = FrictionArmData::new(&arm, &model);
+        for regime in regimes() {
+            let choice = TensionChoice::Policy(TensionPolicy::Safest);
+            let outcome = arm
+                .evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, &f0, choice)
+                .unwrap();
+            assert_eq!(outcome, EndOutcome::Stiff, "{pattern:?} {regime:?}");
+            let k_w = data.k_w().to_owned();
+            assert_ne!(k_w, k_w.transpose(), "{pattern:?}: K_W not symmetric");
+            same_end_as_dense(&out, &mut data, &format!("{pattern:?} {regime:?}"));
+        }
+    }
+}
+
 #[test]
 fn an_unstable_or_singular_sliding_set_is_refused() {
     let f0 = Vector6::from(F0);
