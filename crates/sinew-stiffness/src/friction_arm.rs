@@ -14,8 +14,10 @@
 //!   (`sinew_statics::slip_levels`: the closed form on `J̃` with each cable's actuator limits),
 //!   or given actuator tensions checked against it.
 //!
-//! The end stage is the dense one ([`crate::end_stiffness`]): a slip `K` is not symmetric, and
-//! a routed stick `K` is not block structured.
+//! The end stage is the arm's dense one, with `K_W` from its generators (the same numbers as
+//! [`crate::end_stiffness`] on the dense `K_W`, bit for bit): a slip `K` is not symmetric, and a
+//! routed stick `K` is not block structured. A stick `K` is exactly symmetric, which the end
+//! stage is told, so with a symmetric `K_W` only its lower triangle is formed.
 
 use nalgebra::Vector6;
 use sinew_routing::{
