@@ -30,7 +30,9 @@ pub const WRAP_KINK: f64 = 1e-12;
 /// own formula, so `Σ_s J_s = J_c` bit for bit), `θ_k = atan2(|u_k × u_{k+1}|, u_k · u_{k+1})`,
 /// `∂θ_k/∂q_i = −(∂u_k/∂q_i)·(n × u_k) + (∂u_{k+1}/∂q_i)·(n × u_{k+1})`, with
 /// `∂u/∂q_i · g = (∂d/∂q_i · g) / ℓ` for `g ⊥ u`, `∂o_p/∂q_i = a_i × (o_p − p_i)` for a hole on a
-/// body after joint `i`, and `∂u_0/∂q_i = a_i × u_0`. Cost `O(Σ_s |dofs_s| + Σ_k |wrap dofs_k|)`.
+/// body after joint `i`, and `∂u_0/∂q_i = a_i × u_0`. A joint that moves both ends of a
+/// segment (or the entry direction) turns it rigidly, and its term is then `a_i · n` exactly,
+/// not a difference of two moved ends (`Turn`). Cost `O(Σ_s |dofs_s| + Σ_k |wrap dofs_k|)`.
 ///
 /// # Errors
 /// [`RoutingError::WorkspaceMismatch`] for a model, routing workspace or friction workspace of
@@ -222,47 +224,23 @@ pub fn compute_wrap_gradients(model: &FrictionModel, data: &mut FrictionData) ->
             let (w, sine) = bend(&u_in, &u_out);
             let n = scale(&w, 1.0 / sine);
             let (g_in, g_out) = (cross(&n, &u_in), cross(&n, &u_out));
-            let at = data.positions[e];
-            let (next, b_next) = (data.positions[e + 1], entries[k + 1].hole_body);
-            let b_at = entries[k].hole_body;
+            let (at, b_at) = (data.positions[e], entries[k].hole_body);
             // Incoming: the entry direction turns with hole 0's body (k = 0), else the segment
-            // from hole k − 1: `∂d_in/∂q_i · g_in = term(h_k) − term(h_{k−1})` per moving end.
+            // from hole k − 1; outgoing: the segment to hole k + 1.
             let incoming = if k == 0 {
-                Incoming::Entry(cross(&u_in, &g_in))
+                Turn { rigid: b_at, lone: b_at, moment: [0.0; 3], scale: 0.0 }
             } else {
-                let (before, b_before) = (data.positions[e - 1], entries[k - 1].hole_body);
-                Incoming::Segment {
-                    at: cross(&at, &g_in),
-                    before: cross(&before, &g_in),
-                    bodies: [b_before, b_at],
-                    scale: 1.0 / data.lengths[e],
-                }
+                let ends = [(data.positions[e - 1], entries[k - 1].hole_body), (at, b_at)];
+                Turn::of_segment(ends, &g_in, data.lengths[e])
             };
-            let (out_at, out_next) = (cross(&at, &g_out), cross(&next, &g_out));
-            let out_scale = 1.0 / data.lengths[e + 1];
+            let ends = [(at, b_at), (data.positions[e + 1], entries[k + 1].hole_body)];
+            let outgoing = Turn::of_segment(ends, &g_out, data.lengths[e + 1]);
             for (out, i) in gradient.iter_mut().zip(slot.dofs.clone()) {
                 let axis = data.axes.get(i).ok_or_else(|| mismatch(model.dof))?;
                 let m = data.moments.get(i).ok_or_else(|| mismatch(model.dof))?;
-                let (gm_in, gm_out) = (dot(&g_in, m), dot(&g_out, m));
-                let into = match &incoming {
-                    Incoming::Entry(v) => {
-                        if i < b_at {
-                            dot(axis, v)
-                        } else {
-                            0.0
-                        }
-                    }
-                    Incoming::Segment { at, before, bodies: [b_before, b_at], scale } => {
-                        let moved = |x: &[f64; 3], b: usize| {
-                            if i < b { dot(axis, x) - gm_in } else { 0.0 }
-                        };
-                        (moved(at, *b_at) - moved(before, *b_before)) * scale
-                    }
-                };
-                let moved =
-                    |x: &[f64; 3], b: usize| if i < b { dot(axis, x) - gm_out } else { 0.0 };
-                let outgoing = (moved(&out_next, b_next) - moved(&out_at, b_at)) * out_scale;
-                *out = outgoing - into;
+                let turned = dot(axis, &n);
+                *out = outgoing.along(i, axis, m, &g_out, turned)
+                    - incoming.along(i, axis, m, &g_in, turned);
             }
         }
     }
@@ -278,12 +256,48 @@ fn bend(u_in: &[f64; 3], u_out: &[f64; 3]) -> ([f64; 3], f64) {
     (w, dot(&w, &w).sqrt())
 }
 
-/// What turns the incoming direction at a hole: the entry direction (hole 0: `u_0 × g_in`,
-/// turned by every joint before hole 0's body), or the segment from the hole before
-/// (`h × g_in` at both its ends, their bodies, and `1/ℓ_in`).
-enum Incoming {
-    Entry([f64; 3]),
-    Segment { at: [f64; 3], before: [f64; 3], bodies: [usize; 2], scale: f64 },
+/// How joint `i` turns one of a hole's two directions `u` (unit), as `(∂u/∂q_i) · g` for
+/// `g = n × u` (`n` the unit normal of the hole's bend), the term `∂θ/∂q_i` takes from that side.
+///
+/// - A joint before every body that moves the direction (`i < rigid`) turns it rigidly:
+///   `(a_i × u) · (n × u) = a_i · n` (`u ⊥ n`, `|u| = 1`), the same value on both sides of the
+///   hole, so a joint before every body of the two cancels exactly.
+/// - A joint between a segment's two bodies (`rigid ≤ i < lone`) moves its end on the higher
+///   body alone: `±(a_i · (x × g) − g · m_i) / ℓ`, with `x` that end, `m_i = a_i × p_i`, the sign
+///   `+` when it is the segment's far end (`d = x − other end`), else `−`.
+/// - A joint from the higher body on moves neither end: 0.
+///
+/// The entry direction turns rigidly with hole 0's body (`rigid = lone` = that body).
+struct Turn {
+    rigid: usize,
+    lone: usize,
+    /// `x × g` of the end that moves alone.
+    moment: [f64; 3],
+    /// `±1/ℓ`.
+    scale: f64,
+}
+
+impl Turn {
+    /// The segment with its two ends `(position, body)` in cable order, `g = n × u` for its
+    /// direction `u`, and its length.
+    fn of_segment(ends: [([f64; 3], usize); 2], g: &[f64; 3], length: f64) -> Turn {
+        let [(start, b_start), (end, b_end)] = ends;
+        let (x, sign) = if b_end >= b_start { (end, 1.0) } else { (start, -1.0) };
+        let (rigid, lone) = (b_start.min(b_end), b_start.max(b_end));
+        Turn { rigid, lone, moment: cross(&x, g), scale: sign / length }
+    }
+
+    /// Its term for joint `i` (axis `a`, moment `m`), `turned = a · n`.
+    #[inline]
+    fn along(&self, i: usize, a: &[f64; 3], m: &[f64; 3], g: &[f64; 3], turned: f64) -> f64 {
+        if i < self.rigid {
+            turned
+        } else if i < self.lone {
+            (dot(a, &self.moment) - dot(g, m)) * self.scale
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Routing segment `r`'s unit direction away from the actuator from its two holes `holes`
