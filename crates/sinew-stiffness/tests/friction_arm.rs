@@ -1,7 +1,8 @@
 //! The pipeline with friction at the holes (`ArmStiffness::evaluate_with_friction`, spec §9,
 //! #27) on cdhrm5 at the loaded pose, both routings, μ = 0.1: the tensions of each regime
 //! balance the load through the regime's Jacobian, the dead band's ends reproduce the pull and
-//! release distributions, `K_q` is the regime's, `C_x` is `J_x (K_q + K_W)⁻¹ J_xᵀ` on it, and
+//! release distributions, `K_q` is the regime's, `C_x` is `J_x (K_q + K_W)⁻¹ J_xᵀ` on it (and
+//! `end_stiffness`'s on the dense `K_W`, bit for bit, with and without a moment in the load), and
 //! the levels, given tensions and μ = 0 are refused or checked as documented; a sliding set that
 //! is itself unstable, and one that makes the increment singular, are typed refusals.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -146,13 +147,6 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
     }
 }
 
-/// Sticking holes hold an arm the frictionless model finds unstable (E4's load at the lowest
-/// levels); after a pull a load increment makes some of them slide, and on cdhrm5 the arm they
-/// leave is still stable. A destabilising load stiffness `−c I` added to `K_W` (measured on
-/// this arm: answers up to `c ≈ 0.1 λ`, λ the stick arm's least eigenvalue; no consistent set
-/// of sliding holes from `0.375 λ` to `2.15 λ`, where some sliding sets leave an indefinite
-/// arm; beyond, a consistent set whose arm is unstable) turns each answer into its typed
-/// refusal. The same hole named twice makes the increment's system singular.
 /// `out.end` is `end_stiffness` on the regime's `K_q` and the dense `K_W`, bit for bit.
 fn same_end_as_dense(out: &FrictionArmData, data: &mut ArmStiffnessData, what: &str) {
     let k_q = out.stiffness.stiffness().unwrap().to_owned();
@@ -188,6 +182,13 @@ fn a_load_with_a_moment_ends_as_the_dense_stage() {
     }
 }
 
+/// Sticking holes hold an arm the frictionless model finds unstable (E4's load at the lowest
+/// levels); after a pull a load increment makes some of them slide, and on cdhrm5 the arm they
+/// leave is still stable. A destabilising load stiffness `−c I` added to `K_W` (measured on
+/// this arm: answers up to `c ≈ 0.1 λ`, λ the stick arm's least eigenvalue; no consistent set
+/// of sliding holes from `0.375 λ` to `2.15 λ`, where some sliding sets leave an indefinite
+/// arm; beyond, a consistent set whose arm is unstable) turns each answer into its typed
+/// refusal. The same hole named twice makes the increment's system singular.
 #[test]
 fn an_unstable_or_singular_sliding_set_is_refused() {
     let f0 = Vector6::from(F0);
