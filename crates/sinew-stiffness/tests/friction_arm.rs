@@ -2,7 +2,7 @@
 //! #27) on cdhrm5 at the loaded pose, both routings, μ = 0.1: the tensions of each regime
 //! balance the load through the regime's Jacobian, the dead band's ends reproduce the pull and
 //! release distributions, `K_q` is the regime's, `C_x` is `J_x (K_q + K_W)⁻¹ J_xᵀ` on it (and
-//! `end_stiffness`'s on the dense `K_W`, bit for bit, with and without a moment in the load), and
+//! `end_stiffness`'s on the dense `K_W`, bit for bit, for a load without and with a moment), and
 //! the levels, given tensions and μ = 0 are refused or checked as documented; a sliding set that
 //! is itself unstable, and one that makes the increment singular, are typed refusals.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -43,10 +43,13 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
         let mut data = ArmStiffnessData::new(&arm);
         let mut out = FrictionArmData::new(&arm, &model);
         let n = arm.dof();
-        for regime in regimes() {
+        // E4's load, then one with a moment: a non-symmetric `K_W`, the end stage's general
+        // branch for the symmetric stick `K_q` as for the slip one.
+        let loads = [f0, Vector6::new(0.0, 5.0, 0.0, 0.3, 0.0, 0.2)];
+        for (load, regime) in loads.iter().flat_map(|l| regimes().map(move |r| (l, r))) {
             let choice = TensionChoice::Policy(TensionPolicy::Safest);
             let outcome = arm
-                .evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, &f0, choice)
+                .evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, load, choice)
                 .unwrap();
             assert_eq!(outcome, EndOutcome::Stiff, "{pattern:?} {regime:?}");
             // Balance: −Σ_s T_s J_sᵀ = T0, from the segment tensions and the segment rows.
@@ -84,6 +87,7 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
             let k_q = out.stiffness.stiffness().unwrap().to_owned();
             assert_eq!(out.stiffness.regime(), Some(regime));
             let k_w = data.k_w().to_owned();
+            assert_eq!(k_w == k_w.transpose(), load[3] == 0.0, "{pattern:?}: K_W's symmetry");
             let j_x = data.j_x().to_owned();
             let a = Mat::from_fn(n, n, |i, j| k_q[(i, j)] + k_w[(i, j)]);
             let x = a.partial_piv_lu().solve(j_x.transpose().to_owned());
@@ -101,7 +105,7 @@ fn each_regime_balances_the_load_and_ends_on_its_own_stiffness() {
             assert!(out.stability_margin(&mut data).unwrap() > 0.0);
             // The pipeline's end stage (K_W from its generators) is `end_stiffness` on the
             // dense K_W, bit for bit.
-            same_end_as_dense(&out, &mut data, &format!("{pattern:?} {regime:?}"));
+            same_end_as_dense(&out, &mut data, &format!("{pattern:?} {regime:?} {load:?}"));
         }
         // Stick after equal takes the frictionless statics' tensions (any choice, levels too).
         let levels = TensionChoice::Levels(&[0.5; 5]);
@@ -155,31 +159,6 @@ fn same_end_as_dense(out: &FrictionArmData, data: &mut ArmStiffnessData, what: &
     end_stiffness(k_q.as_ref(), k_w.as_ref(), j_x.as_ref(), &mut dense).unwrap();
     assert_eq!(dense.compliance(), out.end.compliance(), "{what}");
     assert_eq!(dense.stiffness(), out.end.stiffness(), "{what}");
-}
-
-/// With a moment in the load `K_W` is not symmetric: the end stage's general branch, for the
-/// symmetric stick `K_q` as for the slip one, still `end_stiffness`'s numbers bit for bit.
-#[test]
-fn a_load_with_a_moment_ends_as_the_dense_stage() {
-    let f0 = Vector6::new(0.0, 5.0, 0.0, 0.3, 0.0, 0.2);
-    let q = cdhrm5::LOADED_POSE;
-    for pattern in cdhrm5::MODELS {
-        let (robot, routing) = cdhrm5::robot_and_routing(pattern);
-        let arm = ArmStiffness::new(&robot, &routing).unwrap();
-        let model = FrictionModel::new(&routing).with_friction_coefficient(MU).unwrap();
-        let mut data = ArmStiffnessData::new(&arm);
-        let mut out = FrictionArmData::new(&arm, &model);
-        for regime in regimes() {
-            let choice = TensionChoice::Policy(TensionPolicy::Safest);
-            let outcome = arm
-                .evaluate_with_friction(&mut data, &mut out, (&model, regime), &q, &f0, choice)
-                .unwrap();
-            assert_eq!(outcome, EndOutcome::Stiff, "{pattern:?} {regime:?}");
-            let k_w = data.k_w().to_owned();
-            assert_ne!(k_w, k_w.transpose(), "{pattern:?}: K_W not symmetric");
-            same_end_as_dense(&out, &mut data, &format!("{pattern:?} {regime:?}"));
-        }
-    }
 }
 
 /// Sticking holes hold an arm the frictionless model finds unstable (E4's load at the lowest
