@@ -23,7 +23,7 @@
 
 use faer::dyn_stack::MemStack;
 use faer::linalg::cholesky::llt;
-use faer::linalg::lu::partial_pivoting as lu;
+use faer::linalg::lu::partial_pivoting as faer_lu;
 use faer::{Mat, MatRef, Par, Side};
 use sinew_statics::KwGenerators;
 
@@ -31,6 +31,7 @@ use crate::cholesky;
 use crate::colmajor::ColMajor;
 use crate::end_data::EndStiffnessData;
 use crate::error::StiffnessError;
+use crate::lu;
 
 fn check_square(what: &'static str, m: MatRef<'_, f64>, n: usize) -> Result<(), StiffnessError> {
     for got in [m.nrows(), m.ncols()] {
@@ -212,13 +213,38 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
         pulp::Arch::new().dispatch(Gram { l: &data.sym, y: &mut data.y, c_x: &mut data.c_x });
         return true;
     }
+    if n <= lu::SMALL {
+        // X = (K_q + K_W)⁻¹ J_xᵀ, row-major dof × 6 in `y`, by the small LU.
+        for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
+            for (r, v) in row.iter_mut().enumerate() {
+                *v = j_x[(r, k)];
+            }
+        }
+        if !lu::lu_in_place(data.a.as_mut_slice(), n, &mut data.perm) {
+            // A positive definite symmetric part makes K_q + K_W non-singular: only rounding
+            // far beyond any stable arm's gets here.
+            return false;
+        }
+        lu::lu_solve_six(data.a.as_slice(), n, &data.perm, &mut data.y);
+        // C_x = J_x X: 36 dof multiply-adds in plain loops.
+        for (c, out) in data.c_x.chunks_exact_mut(6).enumerate() {
+            let mut col = [0.0; 6];
+            for (k, x) in data.y.chunks_exact(6).enumerate() {
+                for (r, v) in col.iter_mut().enumerate() {
+                    *v += j_x[(r, k)] * x[c];
+                }
+            }
+            out.copy_from_slice(&col);
+        }
+        return true;
+    }
     // X = (K_q + K_W)⁻¹ J_xᵀ.
     for c in 0..6 {
         for r in 0..n {
             data.x[(r, c)] = j_x[(c, r)];
         }
     }
-    let (_, perm) = lu::factor::lu_in_place(
+    let (_, perm) = faer_lu::factor::lu_in_place(
         data.a.as_mut(),
         &mut data.perm,
         &mut data.perm_inv,
@@ -226,7 +252,7 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
         stack,
         Default::default(),
     );
-    lu::solve::solve_in_place(
+    faer_lu::solve::solve_in_place(
         data.a.as_ref(),
         data.a.as_ref(),
         perm,

@@ -46,6 +46,7 @@ mod hole_bounds;
 mod holes;
 mod inherent;
 mod joint;
+mod lu;
 mod outcome;
 mod slip;
 mod stick;
