@@ -10,13 +10,15 @@
 //! rows first). The equilibrium is stable when `K_q + K_W` is positive definite, i.e. when its
 //! symmetric part is (the two coincide when the load is conservative: gravity and forces fixed
 //! in the base frame). Stability is decided by a Cholesky factorisation of the symmetric part
-//! (faer, in place, no allocation); the smallest eigenvalue is computed only to report an
-//! unstable equilibrium, or on request ([`stability_margin`]).
+//! (the crate's own up to 100 DOF, `cholesky.rs`, faer's above; in place, no allocation); the
+//! smallest eigenvalue is computed only to report an unstable equilibrium, or on request
+//! ([`stability_margin`]).
 //!
 //! This is the dense path, `O(dof³)`, for any `K_q` and `K_W`: the reference of the structured
 //! `O(dof)` solve that [`crate::ArmStiffness`] uses when `K_q` is block diagonal (derivation
 //! in `structured/mod.rs`). When `K_q + K_W` is exactly symmetric it is solved with
-//! the Cholesky factor already computed for the verdict, else with a partially pivoted LU.
+//! the Cholesky factor already computed for the verdict, else with a partially pivoted LU (the
+//! crate's own up to `lu::SMALL` DOF, `lu.rs`; faer's above).
 //! `K_x = C_x⁻¹` comes from a 6 × 6 LU with partial pivoting on the stack (the kernel the
 //! structured solve uses for its pivot blocks), whose pivots also decide whether `J_x` has
 //! full rank ([`crate::END_RANK_TOLERANCE`]).
