@@ -283,6 +283,23 @@ mod tests {
         a[9 + 3 * 10] = f64::NAN;
         assert!(!lu_in_place(&mut a, 10, &mut [0; 10]));
         assert!(!lu_in_place(&mut [1.0; 3], 2, &mut [0; 2]));
+        assert!(!lu_in_place(&mut matrix(3, 3.0), 3, &mut [0; 2]));
+    }
+
+    #[test]
+    fn a_solve_of_mismatched_sizes_does_nothing() {
+        let mut a = matrix(3, 3.0);
+        let mut pivots = [0; 3];
+        assert!(lu_in_place(&mut a, 3, &mut pivots));
+        // Each size wrong alone: nothing read out of bounds, nothing written.
+        let mut y = rhs(3);
+        let before = y.clone();
+        lu_solve_six(&a[..8], 3, &pivots, &mut y);
+        lu_solve_six(&a, 3, &pivots[..2], &mut y);
+        assert_eq!(y, before);
+        let mut short = before[..17].to_vec();
+        lu_solve_six(&a, 3, &pivots, &mut short);
+        assert_eq!(short, before[..17]);
     }
 
     /// The workload of `scripts/lu-instructions` (not a test: it asserts nothing): `LU_N`,
