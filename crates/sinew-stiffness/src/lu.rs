@@ -265,6 +265,11 @@ mod tests {
         assert_eq!(pivots, [1, 1]);
         // P A = [[4, 3], [1, 2]] = [[1, 0], [0.25, 1]] [[4, 3], [0, 1.25]].
         assert_eq!(a, [4.0, 0.25, 3.0, 1.25]);
+        // A tie goes to the first row: [[1, 2], [-1, 3]] keeps its order.
+        let mut a = vec![1.0, -1.0, 2.0, 3.0];
+        assert!(lu_in_place(&mut a, 2, &mut pivots));
+        assert_eq!(pivots, [0, 1]);
+        assert_eq!(a, [1.0, -1.0, 2.0, 5.0]);
         // A zero leading entry needs the interchange to factorise at all.
         let mut a = vec![0.0, 1.0, 1.0, 0.0];
         assert!(lu_in_place(&mut a, 2, &mut pivots));
