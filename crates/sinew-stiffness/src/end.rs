@@ -223,8 +223,9 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
             }
         }
         if !lu::lu_in_place(data.a.as_mut_slice(), n, &mut data.perm) {
-            // A positive definite symmetric part makes K_q + K_W non-singular: only rounding
-            // far beyond any stable arm's gets here.
+            // A positive definite symmetric part makes K_q + K_W non-singular (xᵀ A x > 0):
+            // only a matrix singular to working precision gets here, and it is reported as not
+            // stable, with the smallest eigenvalue of its symmetric part.
             return false;
         }
         lu::lu_solve_six(data.a.as_slice(), n, &data.perm, &mut data.y);

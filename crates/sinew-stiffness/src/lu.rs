@@ -1,8 +1,8 @@
 //! The LU factorisation with partial pivoting `P A = L U` of the end's dense solve at small
 //! sizes, for a `K_q + K_W` that is not symmetric (a load with a moment, or a slip regime's
 //! `K_q`): `X = (K_q + K_W)⁻¹ J_xᵀ` (eq. 19; `end.rs`). faer's factorisation is blocked and
-//! recursive, built for large matrices: on the 10 × 10 of cdhrm5 its factorisation and the
-//! solve of six right-hand sides take 11.9 k instructions, for about 700 multiply-adds. Up to
+//! recursive, built for large matrices: at cdhrm5's 10 DOF its factorisation and the solve of
+//! six right-hand sides take 11.9 k instructions, for about 700 multiply-adds. Up to
 //! [`SMALL`] this column-by-column one (left-looking, as [`crate::cholesky`]), compiled for
 //! AVX2 where the processor has it (pulp's runtime dispatch), is used instead; its solutions
 //! agree with faer's to rounding (tests below).
