@@ -205,23 +205,19 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
     if !stable {
         return false;
     }
-    if symmetric {
-        // Y = J_xᵀ row by row (six values per joint), then L⁻¹ in place.
-        for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
-            for (r, v) in row.iter_mut().enumerate() {
-                *v = j_x[(r, k)];
-            }
+    // Y = J_xᵀ row by row (six values per joint): the right-hand sides of either solve.
+    for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
+        for (r, v) in row.iter_mut().enumerate() {
+            *v = j_x[(r, k)];
         }
+    }
+    if symmetric {
+        // L⁻¹ Y in place, then C_x = Yᵀ Y.
         pulp::Arch::new().dispatch(Gram { l: &data.sym, y: &mut data.y, c_x: &mut data.c_x });
         return true;
     }
+    // X = (K_q + K_W)⁻¹ J_xᵀ into `y`: the small LU, or faer's above `lu::SMALL`.
     if n <= lu::SMALL {
-        // X = (K_q + K_W)⁻¹ J_xᵀ, row-major dof × 6 in `y`, by the small LU.
-        for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
-            for (r, v) in row.iter_mut().enumerate() {
-                *v = j_x[(r, k)];
-            }
-        }
         if !lu::lu_in_place(data.a.as_mut_slice(), n, &mut data.perm) {
             // A positive definite symmetric part makes K_q + K_W non-singular (xᵀ A x > 0):
             // only a matrix singular to working precision gets here, and it is reported as not
@@ -229,49 +225,42 @@ fn factor_and_solve(j_x: MatRef<'_, f64>, symmetric: bool, data: &mut EndStiffne
             return false;
         }
         lu::lu_solve_six(data.a.as_slice(), n, &data.perm, &mut data.y);
-        // C_x = J_x X: 36 dof multiply-adds in plain loops.
-        for (c, out) in data.c_x.chunks_exact_mut(6).enumerate() {
-            let mut col = [0.0; 6];
-            for (k, x) in data.y.chunks_exact(6).enumerate() {
-                for (r, v) in col.iter_mut().enumerate() {
-                    *v += j_x[(r, k)] * x[c];
-                }
+    } else {
+        for (k, row) in data.y.chunks_exact(6).enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                data.x[(k, c)] = *v;
             }
-            out.copy_from_slice(&col);
         }
-        return true;
-    }
-    // X = (K_q + K_W)⁻¹ J_xᵀ.
-    for c in 0..6 {
-        for r in 0..n {
-            data.x[(r, c)] = j_x[(c, r)];
+        let (_, perm) = faer_lu::factor::lu_in_place(
+            data.a.as_mut(),
+            &mut data.perm,
+            &mut data.perm_inv,
+            Par::Seq,
+            stack,
+            Default::default(),
+        );
+        faer_lu::solve::solve_in_place(
+            data.a.as_ref(),
+            data.a.as_ref(),
+            perm,
+            data.x.as_mut(),
+            Par::Seq,
+            stack,
+        );
+        for (k, row) in data.y.chunks_exact_mut(6).enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = data.x[(k, c)];
+            }
         }
     }
-    let (_, perm) = faer_lu::factor::lu_in_place(
-        data.a.as_mut(),
-        &mut data.perm,
-        &mut data.perm_inv,
-        Par::Seq,
-        stack,
-        Default::default(),
-    );
-    faer_lu::solve::solve_in_place(
-        data.a.as_ref(),
-        data.a.as_ref(),
-        perm,
-        data.x.as_mut(),
-        Par::Seq,
-        stack,
-    );
     // C_x = J_x X: 36 dof multiply-adds in plain loops. (faer's matmul here returned with the
     // vector registers' upper halves dirty on the project machine, which slowed the scalar code
     // of the next evaluation threefold; see docs/performance.md.)
     for (c, out) in data.c_x.chunks_exact_mut(6).enumerate() {
         let mut col = [0.0; 6];
-        for k in 0..n {
-            let x = data.x[(k, c)];
+        for (k, x) in data.y.chunks_exact(6).enumerate() {
             for (r, v) in col.iter_mut().enumerate() {
-                *v += j_x[(r, k)] * x;
+                *v += j_x[(r, k)] * x[c];
             }
         }
         out.copy_from_slice(&col);

@@ -95,9 +95,9 @@ pub struct EndStiffnessData {
     pub(crate) a: ColMajor,
     /// Symmetric part of `K_q + K_W`, then its Cholesky factor.
     pub(crate) sym: ColMajor,
-    /// `(K_q + K_W)⁻¹ J_xᵀ` (dof × 6), the non-symmetric case.
+    /// faer's solve of the non-symmetric case above `lu::SMALL` DOF (dof × 6).
     pub(crate) x: Mat<f64>,
-    /// `L⁻¹ J_xᵀ`, row-major dof × 6, the symmetric case.
+    /// `J_xᵀ`, then `L⁻¹ J_xᵀ` (the symmetric case) or `(K_q + K_W)⁻¹ J_xᵀ`: row-major dof × 6.
     pub(crate) y: Vec<f64>,
     /// `C_x`, column-major 6 × 6.
     pub(crate) c_x: [f64; 36],
