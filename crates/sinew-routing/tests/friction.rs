@@ -13,9 +13,9 @@
 
 use sinew_robot::{Robot, RobotData};
 use sinew_routing::{
-    CableFriction, ExplicitCable, FrictionData, FrictionModel, HoleSpec, Order, PatternModel,
-    Routing, RoutingData, Slip, compute_cable_geometry, compute_capstan_weights,
-    compute_friction_angles, compute_friction_geometry, compute_wrap_gradients,
+    CableFriction, FrictionData, FrictionModel, Order, PatternModel, Routing, RoutingData, Slip,
+    compute_cable_geometry, compute_capstan_weights, compute_friction_angles,
+    compute_friction_geometry, compute_wrap_gradients,
 };
 use sinew_testkit::cdhrm5;
 use sinew_testkit::config::{random_q, random_qs, rng};
@@ -88,42 +88,12 @@ fn cases() -> Vec<(String, Robot, Routing, [f64; 6])> {
         let routing = chain.routing(&robot, &spec);
         out.push((format!("{} explicit", chain.name), robot, routing, RANDOM_TOL));
     }
-    // A cable that runs back toward the base between two holes (link2 → link1): its middle
-    // segment's routing ends are swapped against the cable's direction.
+    // Two cables that run back toward the base (link2 → link1), one of them from its first
+    // segment (`RandomChain::turning_back_cables`).
     let chain = RandomChain::new(2, 5);
     let robot = chain.robot();
     let mut spec = chain.explicit_spec(5);
-    let hole = |link: &str, point: [f64; 3]| HoleSpec { link: link.to_owned(), point };
-    spec.cables.push(ExplicitCable {
-        name: "zigzag".to_owned(),
-        joint: None,
-        free_length: None,
-        tension_limits: None,
-        friction_coefficient: None,
-        entry_direction: Some([0.3, -0.2, 1.0]),
-        holes: vec![
-            hole("base_link", [0.02, 0.0, 0.001]),
-            hole("link2", [0.0, 0.02, -0.002]),
-            hole("link1", [-0.02, 0.0, 0.003]),
-            hole("link2", [0.0, -0.02, 0.002]),
-        ],
-    });
-    // And one whose first segment runs back toward the base (link2 → link1): only then does the
-    // entry direction's own turning reach θ_0's gradient (before the first segment's lower
-    // body it turns both directions rigidly and cancels).
-    spec.cables.push(ExplicitCable {
-        name: "backward".to_owned(),
-        joint: None,
-        free_length: None,
-        tension_limits: None,
-        friction_coefficient: None,
-        entry_direction: Some([-0.2, 0.1, -1.0]),
-        holes: vec![
-            hole("link2", [0.0, 0.02, -0.002]),
-            hole("link1", [-0.02, 0.0, 0.003]),
-            hole("link2", [0.0, -0.02, 0.002]),
-        ],
-    });
+    spec.cables.extend(RandomChain::turning_back_cables());
     let routing = chain.routing(&robot, &spec);
     let zigzag = &routing.cables()[routing.cable_index("zigzag").unwrap()];
     assert!(zigzag.holes[1].body_point.body > zigzag.holes[2].body_point.body);

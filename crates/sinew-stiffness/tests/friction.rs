@@ -6,7 +6,8 @@
 //! Criterion for each comparison, per case over its configurations: `max |analytic − FD| ≤
 //! tol · max |analytic|`, `tol` a few times the worst error measured (beside each bound;
 //! `--nocapture` prints them). Cases: cdhrm5 in both routing files and seeded random-geometry
-//! chains (pattern routings, decoupled and routed, and an explicit routing), μ = 0.2.
+//! chains (pattern routings, decoupled and routed, an explicit routing, and one with two cables
+//! that run back toward the base), μ = 0.2.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::{Mat, MatRef};
@@ -45,8 +46,9 @@ fn evaluate(robot: &Robot, routing: &Routing, model: &FrictionModel, q: &[f64]) 
 }
 
 /// `(name, robot, routing, tolerances [slip vs FD of τ, stick vs FD of the energy])`, each a
-/// few times the worst measured: slip 2.6e-9 (cdhrm5), 2.2e-9 (random chains); stick 2.2e-8
-/// (cdhrm5), 5.4e-8 (random chains; second differences of the energy at h = 1e-4).
+/// few times the worst measured: slip 2.6e-9 (cdhrm5), 2.2e-9 (random chains), 1.8e-9 (turning
+/// back); stick 2.2e-8 (cdhrm5), 5.4e-8 (random chains; second differences of the energy at
+/// h = 1e-4), 4.7e-8 (turning back).
 fn cases() -> Vec<(String, Robot, Routing, [f64; 2])> {
     let mut out = Vec::new();
     for model in cdhrm5::MODELS {
@@ -63,6 +65,15 @@ fn cases() -> Vec<(String, Robot, Routing, [f64; 2])> {
         let routing = chain.routing(&robot, &chain.explicit_spec(seed));
         out.push((format!("{} explicit", chain.name), robot, routing, [1e-8, 2e-7]));
     }
+    // Two cables that run back toward the base, two of their segments across one DOF: the only
+    // case where the slip stiffness's running sum `G_k` adds two segments' `J_s` on one DOF (a
+    // sum that overwrote instead of adding passed every other case).
+    let chain = RandomChain::new(2, 5);
+    let robot = chain.robot();
+    let mut spec = chain.explicit_spec(5);
+    spec.cables.extend(RandomChain::turning_back_cables());
+    let routing = chain.routing(&robot, &spec);
+    out.push(("turning back".to_owned(), robot, routing, [1e-8, 2e-7]));
     out
 }
 

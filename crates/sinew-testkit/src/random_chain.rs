@@ -382,6 +382,39 @@ impl RandomChain {
         RoutingSpec { cables, ..self.common_spec(PerJoint::Uniform(3.0)) }
     }
 
+    /// Two explicit cables that run back toward the base, for a chain of two or more joints
+    /// (the friction tests' cases that take the general paths):
+    /// - `zigzag` (entry direction given): base → `link2` → `link1` → `link2`, its middle
+    ///   segment's routing ends swapped against the cable's direction;
+    /// - `backward`: `link2` → `link1` → `link2`, its first segment run back toward the base,
+    ///   the one case where the entry direction's own turning reaches `∂θ_0/∂Q` (before the
+    ///   first segment's lower body it turns both directions rigidly and cancels).
+    ///
+    /// Both have two segments across one DOF.
+    pub fn turning_back_cables() -> [ExplicitCable; 2] {
+        let hole = |link: &str, point: [f64; 3]| HoleSpec { link: link.to_owned(), point };
+        let cable = |name: &str, entry_direction: [f64; 3], holes: Vec<HoleSpec>| ExplicitCable {
+            name: name.to_owned(),
+            joint: None,
+            free_length: None,
+            tension_limits: None,
+            friction_coefficient: None,
+            entry_direction: Some(entry_direction),
+            holes,
+        };
+        let (up, back, down) = (
+            hole("link2", [0.0, 0.02, -0.002]),
+            hole("link1", [-0.02, 0.0, 0.003]),
+            hole("link2", [0.0, -0.02, 0.002]),
+        );
+        let zigzag =
+            vec![hole("base_link", [0.02, 0.0, 0.001]), up.clone(), back.clone(), down.clone()];
+        [
+            cable("zigzag", [0.3, -0.2, 1.0], zigzag),
+            cable("backward", [-0.2, 0.1, -1.0], vec![up, back, down]),
+        ]
+    }
+
     /// The routing of `spec` on [`RandomChain::robot`].
     ///
     /// # Panics
