@@ -214,6 +214,14 @@ fn an_unstable_or_singular_sliding_set_is_refused() {
     };
     let [plus, minus] = respond(0.0).unwrap();
     assert!(plus.stiffness > 0.0 && minus.stiffness > 0.0 && plus.stiffness != minus.stiffness);
+    // A zero direction, or one with a NaN, is bad input (each alone: cargo mutants found the
+    // check with `&&` for `||` unnoticed, which lets both through).
+    for bad in [Vector6::zeros(), Vector6::new(0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0)] {
+        let e = directional_response(&model, &routing, f, History::Pull, t, increment, &bad)
+            .unwrap_err();
+        assert!(matches!(e, StiffnessError::InvalidWrenchDirection { .. }), "{e}");
+        assert_eq!(e.kind(), sinew_robot::ErrorKind::Input);
+    }
     let e = *respond(least).unwrap_err();
     assert!(matches!(e, StiffnessError::NoConsistentSliding { passes } if passes > 0), "{e}");
     let e = *respond(3.0 * least).unwrap_err();
