@@ -522,6 +522,10 @@ fn the_directional_response_is_consistent_and_shows_hysteresis() {
                     !one.sliding.is_empty(),
                     "{pattern:?} {u:?}: a pull leaves every hole on an edge"
                 );
+                // Reported cable by cable, hole by hole, as documented.
+                let order: Vec<(usize, usize)> =
+                    one.sliding.iter().map(|e| (e.cable, e.hole)).collect();
+                assert!(order.windows(2).all(|w| w[0] < w[1]), "{pattern:?} {u:?}: {order:?}");
                 for (e, f) in one.sliding.iter().zip(&one.flux) {
                     assert_eq!(e.edge, BandEdge::Lower);
                     assert!(
