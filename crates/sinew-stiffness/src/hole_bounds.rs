@@ -184,3 +184,77 @@ impl HoleBounds {
 fn may_reach(bound: f64, best: f64) -> bool {
     bound.partial_cmp(&(best * (1.0 + SKIP_MARGIN))) != Some(std::cmp::Ordering::Greater)
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use rand::Rng;
+    use sinew_robot::RobotData;
+    use sinew_routing::{
+        FrictionData, FrictionModel, Order, RoutingData, compute_cable_geometry,
+        compute_friction_geometry,
+    };
+    use sinew_testkit::cdhrm5;
+    use sinew_testkit::config::rng;
+
+    use super::*;
+    use crate::History;
+    use crate::holes::{dot, holes};
+
+    /// The bound itself, not only the answers it leaves unchanged (`tests/stick_limit_scan.rs`):
+    /// along random joint motions, every grouped hole's rate at each edge obeys
+    /// `|ġ| ≤ ρ m`, that is `β |ġ| ≤ g m` with `m` the largest `|δQ_i|` over its group's DOFs,
+    /// and the bound is not vacuous: for every hole, the largest `β |ġ| / (g m)` seen is near
+    /// one. A `ρ` that drops a term or a factor breaks the first (a hole skipped that may be
+    /// reached first, which the answers show only when that hole is the first); one that grows
+    /// breaks the second (holes no longer skipped).
+    #[test]
+    fn every_bound_holds_along_random_motions_and_is_near_tight() {
+        for pattern in cdhrm5::MODELS {
+            let (robot, routing) = cdhrm5::robot_and_routing(pattern);
+            let (n, m) = (routing.dof(), routing.cable_count());
+            let mut rdata = RobotData::new(&robot);
+            let mut geometry = RoutingData::new(&routing);
+            let (q, order) = (cdhrm5::LOADED_POSE, Order::Jacobian);
+            compute_cable_geometry(&routing, &robot, &mut rdata, &mut geometry, &q, order).unwrap();
+            let model = FrictionModel::new(&routing).with_friction_coefficient(0.2).unwrap();
+            let mut friction = FrictionData::new(&model);
+            compute_friction_geometry(&model, &routing, &geometry, &mut friction).unwrap();
+            let t: Vec<f64> = (0..m).map(|c| 50.0 + 10.0 * c as f64).collect();
+            let holes = holes(&model, &routing, &friction, History::Equal, &t).unwrap();
+            let cables: Vec<CableRows<'_>> =
+                (0..m).map(|c| friction.cable(&model, c).unwrap()).collect();
+            // After `equal` every band has room: no hole is handed over unbounded.
+            let bounds =
+                HoleBounds::walk(&cables, &holes, n, false, |_| panic!("on an edge")).unwrap();
+            assert_eq!(bounds.members.len(), holes.len(), "{pattern:?}: every hole grouped");
+            let mut r = rng(17);
+            // Per hole, the largest ratio over the motions.
+            let mut tightest = vec![0.0_f64; holes.len()];
+            for _ in 0..200 {
+                let dq: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
+                for group in &bounds.groups {
+                    let motion =
+                        dq[group.dofs.clone()].iter().fold(0.0, |a: f64, x| a.max(x.abs()));
+                    for &(beta, i) in &bounds.members[group.members.clone()] {
+                        let h = &holes[i];
+                        let cable = &cables[h.cable];
+                        let after = dot(&cable.jacobian(h.hole + 1), &dq);
+                        let before = dot(&cable.jacobian(h.hole), &dq);
+                        let turn = dot(&cable.wrap_gradient(h.hole).unwrap(), &dq);
+                        for (edge, (a, b, d), g, _) in h.edges() {
+                            let rate =
+                                a * h.springs[1] * after + b * h.springs[0] * before + d * turn;
+                            let ratio = beta * rate.abs() / (g * motion);
+                            assert!(ratio <= 1.0 + 1e-12, "{pattern:?} {edge:?} {h:?}: {ratio}");
+                            tightest[i] = tightest[i].max(ratio);
+                        }
+                    }
+                }
+            }
+            let loosest = tightest.iter().fold(f64::INFINITY, |a: f64, &x| a.min(x));
+            println!("{pattern:?}: per hole, the largest β|ġ|/(g m) of 200 motions ≥ {loosest:.3}");
+            assert!(loosest > 0.8, "{pattern:?}: a loose bound (measured ≥ 0.969)");
+        }
+    }
+}
