@@ -554,6 +554,26 @@ fn the_directional_response_is_consistent_and_shows_hysteresis() {
             );
         }
         assert!(hysteresis > 1e-3, "{pattern:?}: ±u give the same compliance ({hysteresis:.1e})");
+        // After a release every hole is on its upper edge: those that slide, slide away from
+        // the actuator (cargo mutants: the upper edge's flux sign taken as the lower one's went
+        // unnoticed while only pull was tested), and sliding only softens.
+        let s = setup(pattern, History::Release);
+        for u in base_directions().into_iter().step_by(2) {
+            let (m, r, f, t) = (&s.model, &s.routing, &s.friction, &s.actuator);
+            let both =
+                directional_response(m, r, f, History::Release, t, s.increment(), &u).unwrap();
+            let dq = response(&s.k_stick, &s.k_w, &s.j_x, &u);
+            let stick_compliance: f64 =
+                (0..6).map(|r| u[r] * (0..10).map(|i| s.j_x[(r, i)] * dq[i]).sum::<f64>()).sum();
+            for one in &both {
+                assert!(!one.sliding.is_empty(), "{pattern:?} {u:?}: every hole on an edge");
+                for (e, f) in one.sliding.iter().zip(&one.flux) {
+                    assert_eq!(e.edge, BandEdge::Upper);
+                    assert!(*f >= 0.0, "{pattern:?}: {e:?} slides toward the actuator ({f:.1e})");
+                }
+                assert!(one.compliance >= stick_compliance * (1.0 - 1e-12), "{pattern:?}");
+            }
+        }
     }
 }
 
