@@ -207,9 +207,12 @@ mod tests {
     /// and the bound is not vacuous: for every hole, the largest `β |ġ| / (g m)` seen is near
     /// one. A `ρ` that drops a term or a factor breaks the first (a hole skipped that may be
     /// reached first, which the answers show only when that hole is the first); one that grows
-    /// breaks the second (holes no longer skipped).
+    /// breaks the second (holes no longer skipped). Then [`HoleBounds::search`] along motions
+    /// of every size: it must find the least `α` of all holes while handing over less than half
+    /// of them (a group's or hole's bound with `m` on the wrong side of `β`, or a search that
+    /// skips nothing, fails it).
     #[test]
-    fn every_bound_holds_along_random_motions_and_is_near_tight() {
+    fn every_bound_holds_is_near_tight_and_the_search_finds_the_least_alpha() {
         for pattern in cdhrm5::MODELS {
             let (robot, routing) = cdhrm5::robot_and_routing(pattern);
             let (n, m) = (routing.dof(), routing.cable_count());
@@ -255,6 +258,42 @@ mod tests {
             let loosest = tightest.iter().fold(f64::INFINITY, |a: f64, &x| a.min(x));
             println!("{pattern:?}: per hole, the largest β|ġ|/(g m) of 200 motions ≥ {loosest:.3}");
             assert!(loosest > 0.8, "{pattern:?}: a loose bound (measured ≥ 0.969)");
+            // The search: along each motion it finds the least α of all holes, handing over
+            // only part of them (a search that skipped on a wrong bound misses the least α now
+            // and then; one that skipped nothing hands over every hole).
+            let alpha = |i: usize, dq: &[f64]| {
+                let h = &holes[i];
+                let cable = &cables[h.cable];
+                let after = dot(&cable.jacobian(h.hole + 1), dq);
+                let before = dot(&cable.jacobian(h.hole), dq);
+                let turn = dot(&cable.wrap_gradient(h.hole).unwrap(), dq);
+                h.edges().iter().fold(f64::INFINITY, |least, &(_, (a, b, d), g, _)| {
+                    let rate = a * h.springs[1] * after + b * h.springs[0] * before + d * turn;
+                    if rate < 0.0 { least.min(g / -rate) } else { least }
+                })
+            };
+            let (mut scratch, mut handed) = (Vec::new(), 0);
+            for _ in 0..200 {
+                // Of every size, so that a bound with `m` on the wrong side of `β` errs.
+                let size = 10.0_f64.powf(r.random_range(-2.0..2.0));
+                let dq: Vec<f64> = (0..n).map(|_| size * r.random_range(-1.0..1.0)).collect();
+                let mut best: Best = (f64::INFINITY, usize::MAX, None);
+                bounds
+                    .search(&dq, &mut scratch, &mut best, |i, best| {
+                        handed += 1;
+                        let a = alpha(i, &dq);
+                        if a < best.0 {
+                            (best.0, best.1) = (a, i);
+                        }
+                        Ok(())
+                    })
+                    .unwrap();
+                let least = (0..holes.len()).map(|i| alpha(i, &dq)).fold(f64::INFINITY, f64::min);
+                assert_eq!(best.0, least, "{pattern:?}: the search missed the least α");
+            }
+            let share = handed as f64 / (200 * holes.len()) as f64;
+            println!("{pattern:?}: the search handed over {:.1} % of the holes", 100.0 * share);
+            assert!(share < 0.5, "{pattern:?}: the search skips too little (measured 23 %, 6 %)");
         }
     }
 }
