@@ -277,3 +277,35 @@ fn check(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The documented order: `+e_i` then `−e_i`, force x, y, z, then moment x, y, z.
+    #[test]
+    fn base_directions_are_in_their_documented_order() {
+        let base = base_directions();
+        for (k, u) in base.iter().enumerate() {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let expected = Vector6::from_fn(|i, _| if i == k / 2 { sign } else { 0.0 });
+            assert_eq!(*u, expected, "direction {k}");
+        }
+    }
+
+    /// Each direction is paired with the first later exact negation not yet taken, so that the
+    /// base directions cost six solves, and a repeated direction is computed on its own.
+    #[test]
+    fn mirror_pairs_take_each_negation_once() {
+        let pairs = mirror_pairs(&base_directions());
+        let expected: Vec<_> = (0..6).map(|i| (2 * i, Some(2 * i + 1))).collect();
+        assert_eq!(pairs, expected);
+        let u = Vector6::new(0.3, 1.0, -0.2, 0.0, 0.0, 0.1);
+        assert_eq!(mirror_pairs(&[u, -u, -u, u]), vec![(0, Some(1)), (2, Some(3))]);
+        assert_eq!(mirror_pairs(&[u, -u, -u]), vec![(0, Some(1)), (2, None)]);
+        assert_eq!(
+            mirror_pairs(&[u, 0.5 * u, -(1.0 + 1e-15) * u]),
+            vec![(0, None), (1, None), (2, None)]
+        );
+    }
+}

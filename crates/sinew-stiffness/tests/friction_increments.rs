@@ -421,6 +421,15 @@ fn bad_input_is_refused() {
         StiffnessError::Unstable { min_eigenvalue } => assert_eq!(min_eigenvalue, -2.0),
         e => panic!("{e}"),
     }
+    // Unstable along (1, …, 1) only: I − 1.1 · 11ᵀ/n, least eigenvalue −0.1 (a symmetric part
+    // formed as 0.5 + (K + Kᵀ) instead of 0.5 (K + Kᵀ) adds 0.5 · 11ᵀ and hides it).
+    let ones = Mat::<f64>::from_fn(n, n, |i, j| f64::from(u8::from(i == j)) - 1.1 / n as f64);
+    match *call(&model, History::Equal, &ones, u).unwrap_err() {
+        StiffnessError::Unstable { min_eigenvalue } => {
+            assert!((min_eigenvalue + 0.1).abs() < 1e-12, "{min_eigenvalue}")
+        }
+        e => panic!("{e}"),
+    }
     // Pull without the pull weights; μ = 0 (no band to stick in).
     let e = call(&model, History::Pull, &eye, u).unwrap_err();
     assert!(matches!(*e, StiffnessError::WrongCapstanWeights { .. }), "{e}");
