@@ -25,8 +25,8 @@
 //!
 //! Every step keeps the segment directions, as `evaluate_with_friction` does
 //! (`RoutingData::keep_segment_directions`). Until session 26 the steps did not, so their
-//! friction geometry recomputed each direction: `part: friction geometry` measured about
-//! 94 µs at 50 DOF where the pipeline's takes about 53 µs.
+//! friction geometry recomputed each direction: `part: friction geometry` measured 93.5 µs at
+//! 50 DOF, 56.4 µs with the directions kept (docs/performance.md, session 26).
 //!
 //! The tensions are the pipeline's own at the pose (their values do not change the cost).
 //! docs/performance.md ("Issue #27: what friction costs") has the numbers.

@@ -383,14 +383,12 @@ impl RandomChain {
     }
 
     /// Two explicit cables that run back toward the base, for a chain of two or more joints
-    /// (the friction tests' cases that take the general paths):
+    /// (the friction tests' cases where two segments of one cable cross one DOF):
     /// - `zigzag` (entry direction given): base → `link2` → `link1` → `link2`, its middle
     ///   segment's routing ends swapped against the cable's direction;
     /// - `backward`: `link2` → `link1` → `link2`, its first segment run back toward the base,
     ///   the one case where the entry direction's own turning reaches `∂θ_0/∂Q` (before the
     ///   first segment's lower body it turns both directions rigidly and cancels).
-    ///
-    /// Both have two segments across one DOF.
     pub fn turning_back_cables() -> [ExplicitCable; 2] {
         let hole = |link: &str, point: [f64; 3]| HoleSpec { link: link.to_owned(), point };
         let cable = |name: &str, entry_direction: [f64; 3], holes: Vec<HoleSpec>| ExplicitCable {
